@@ -1,0 +1,120 @@
+// The scene as loaders produce it and renderers consume it: world-space meshes
+// (node transforms already applied), metal-roughness materials, image sources
+// (decoded later by texture.h) and punctual lights.
+//
+// UV convention inside the project: glTF's, v = 0 is the TOP row of an image.
+// The OBJ loader converts (v_internal = 1 - v_obj), so samplers and tangent
+// generation follow one rule: T runs along +u, and the normal-map bitangent
+// B = cross(N, T) * w points towards -v (up the image), see conventions.md.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace prast {
+
+// A bad input file: what() is one line, "FILE: problem".
+struct LoadError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// Where an image's bytes come from: a file on disk, or bytes embedded in a
+// .glb / data URI. Decoding happens in texture.h.
+struct ImageSource {
+    std::string path;                 // file path, empty when embedded
+    std::vector<unsigned char> bytes; // embedded encoded bytes (PNG/JPEG)
+    std::string name;                 // for messages: path or "file.glb#image3"
+};
+
+enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
+
+struct TextureRef {
+    int image = -1;              // index into Scene::images; -1 = none
+    Wrap wrap_s = Wrap::Repeat;
+    Wrap wrap_t = Wrap::Repeat;
+    int texcoord = 0;            // only set 0 is carried; others warn
+    bool valid() const { return image >= 0; }
+};
+
+enum class AlphaMode { Opaque, Mask, Blend };
+
+// Measured metals for the conductor (complex index) Fresnel; None = Schlick
+// with F0 from ior and albedo as the conventions say.
+enum class Conductor { None, Gold, Copper, Aluminium, Silver };
+
+struct Material {
+    std::string name = "default";
+    glm::vec4 base_color_factor{0.8f, 0.8f, 0.8f, 1.0f};
+    float metallic_factor = 0.0f;
+    float roughness_factor = 0.5f;
+    glm::vec3 emissive_factor{0.0f};
+    float normal_scale = 1.0f;
+    float occlusion_strength = 1.0f;
+    float ior = 1.5f;
+
+    TextureRef base_color;          // sRGB, RGBA
+    TextureRef metallic_roughness;  // glTF packed: roughness G, metallic B
+    TextureRef roughness;           // separate map (OBJ map_Pr): R
+    TextureRef metallic;            // separate map (OBJ map_Pm): R
+    TextureRef normal;              // tangent space, OpenGL convention
+    TextureRef occlusion;           // R
+    TextureRef emissive;            // sRGB
+
+    AlphaMode alpha_mode = AlphaMode::Opaque;
+    float alpha_cutoff = 0.5f;
+    bool double_sided = false;
+    Conductor conductor = Conductor::None;
+};
+
+struct Mesh {
+    std::string name;
+    std::vector<glm::vec3> positions;  // world space
+    std::vector<glm::vec3> normals;    // world space, unit; always filled by loaders
+    std::vector<glm::vec2> uvs;        // internal (v = 0 top) convention; may be empty
+    std::vector<glm::vec4> tangents;   // xyz + handedness w; filled when uvs exist
+    std::vector<std::uint32_t> indices; // triangle list
+    int material = 0;                  // index into Scene::materials
+};
+
+struct Light {
+    enum class Type { Directional, Point };
+    Type type = Type::Directional;
+    glm::vec3 direction{0.0f, 1.0f, 0.0f}; // directional: unit vector TOWARDS the light
+    glm::vec3 position{0.0f};              // point
+    glm::vec3 color{1.0f};
+    float intensity = 1.0f;                // radiance = color * intensity (/ d^2 for points)
+};
+
+struct Bounds {
+    glm::vec3 lo{1e30f}, hi{-1e30f};
+    bool empty() const { return lo.x > hi.x; }
+    void add(const glm::vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+    glm::vec3 center() const { return (lo + hi) * 0.5f; }
+    float radius() const { return empty() ? 0.0f : glm::length(hi - lo) * 0.5f; }
+};
+
+struct Scene {
+    std::vector<Mesh> meshes;
+    std::vector<Material> materials;     // never empty after loading
+    std::vector<ImageSource> images;
+    std::vector<Light> lights;           // from the file (KHR_lights_punctual)
+    std::vector<std::string> warnings;   // one line each: "FILE: what was ignored/fallen back"
+
+    Bounds bounds() const {
+        Bounds b;
+        for (const Mesh& m : meshes)
+            for (const glm::vec3& p : m.positions) b.add(p);
+        return b;
+    }
+    std::size_t triangle_count() const {
+        std::size_t n = 0;
+        for (const Mesh& m : meshes) n += m.indices.size() / 3;
+        return n;
+    }
+};
+
+} // namespace prast

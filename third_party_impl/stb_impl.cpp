@@ -1,0 +1,7 @@
+// The one translation unit that compiles stb_image and stb_image_write.
+// Large or hostile images are refused before allocation (see shading/image_io).
+#define STBI_MAX_DIMENSIONS (1 << 15)
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb_image.h>
+#include <stb_image_write.h>

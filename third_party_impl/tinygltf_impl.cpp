@@ -1,0 +1,9 @@
+// The one translation unit that compiles tinygltf. Images are decoded by our own
+// loader (shading/), so tinygltf only keeps their bytes; stb_image is compiled
+// once in stb_impl.cpp.
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_INCLUDE_STB_IMAGE
+#define TINYGLTF_NO_INCLUDE_STB_IMAGE_WRITE
+#include <tiny_gltf.h>
