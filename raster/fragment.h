@@ -1,0 +1,44 @@
+// What a fragment shader sees and returns. The rasterizer hands a shader one 4x4
+// pixel block at a time: four 2x2 quads, 16 lanes in structure-of-arrays form,
+// so a shader's per-lane loop vectorises. Lane order is quad-major:
+//   lane = 4 * quad + pixel,  quad = qx + 2 qy,  pixel = px + 2 py,
+// which keeps each quad's four lanes adjacent for screen-space derivatives.
+// Lanes outside the triangle (helper lanes) still carry extrapolated varyings,
+// so derivatives are valid for every quad that has at least one live lane.
+#pragma once
+
+#include <cstdint>
+
+#include "raster/limits.h"
+
+namespace prast {
+
+constexpr int lane_x(int lane) { return ((lane >> 2) & 1) * 2 + (lane & 1); }
+constexpr int lane_y(int lane) { return ((lane >> 3) & 1) * 2 + ((lane >> 1) & 1); }
+
+template <int NV>
+struct FragmentBlock {
+    static constexpr int kVaryings = NV;
+    alignas(64) float var[NV > 0 ? NV : 1][kBlockLanes]; // perspective-correct varyings
+    alignas(64) float z[kBlockLanes];                    // window depth, linear in screen space
+    int x = 0, y = 0;          // pixel of lane 0 (top-left of the block)
+    std::uint32_t mask = 0;    // live lanes: covered and passed the depth test
+    std::uint32_t prim_id = 0; // index of the submitted triangle in the draw
+    bool front_facing = true;
+
+    bool quad_live(int quad) const { return (mask >> (quad * 4)) & 0xFu; }
+    // Coarse derivatives, one per quad (the OpenGL spec allows it): x from the
+    // top row of the quad, y from its left column.
+    float ddx(int k, int lane) const { int q = lane & ~3; return var[k][q + 1] - var[k][q]; }
+    float ddy(int k, int lane) const { int q = lane & ~3; return var[k][q + 2] - var[k][q]; }
+};
+
+struct FragmentOut {
+    alignas(64) float r[kBlockLanes];
+    alignas(64) float g[kBlockLanes];
+    alignas(64) float b[kBlockLanes];
+    alignas(64) float a[kBlockLanes];
+    std::uint32_t kill = 0;  // lanes the shader discards (alpha mask)
+};
+
+} // namespace prast

@@ -1,0 +1,35 @@
+// The render target: linear float RGBA colour and float depth, row-major, row 0
+// at the top. Depth is 32-bit float window z in [0, 1], cleared to 1, test LESS.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace prast {
+
+struct Framebuffer {
+    int width = 0, height = 0;
+    std::vector<float> color;  // 4 floats per pixel
+    std::vector<float> depth;  // 1 float per pixel
+
+    Framebuffer() = default;
+    Framebuffer(int w, int h) { resize(w, h); }
+
+    void resize(int w, int h) {
+        width = w;
+        height = h;
+        color.assign(std::size_t(w) * h * 4, 0.0f);
+        depth.assign(std::size_t(w) * h, 1.0f);
+    }
+    void clear(float r, float g, float b, float a, float z = 1.0f) {
+        for (std::size_t i = 0; i < color.size(); i += 4) {
+            color[i] = r; color[i + 1] = g; color[i + 2] = b; color[i + 3] = a;
+        }
+        std::fill(depth.begin(), depth.end(), z);
+    }
+    float* pixel(int x, int y) { return &color[(std::size_t(y) * width + x) * 4]; }
+    const float* pixel(int x, int y) const { return &color[(std::size_t(y) * width + x) * 4]; }
+};
+
+} // namespace prast

@@ -1,0 +1,91 @@
+// Triangle setup in fixed point; see setup.h.
+#include "raster/setup.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace prast {
+
+SetupResult setup_triangle(const float* const clip[3], const std::uint32_t ref[3],
+                           int width, int height, bool cull_back, TriangleSetup& t) {
+    // Project to window space (y down, conventions.md) and snap to 1/256 pixel.
+    // Double precision so that vertices far out in the guard band snap exactly.
+    std::int64_t fx[3], fy[3];
+    float z[3], inv_w[3];
+    for (int i = 0; i < 3; ++i) {
+        double w = clip[i][3];
+        double x_win = (double(clip[i][0]) / w + 1.0) * 0.5 * width;
+        double y_win = (1.0 - double(clip[i][1]) / w) * 0.5 * height;
+        fx[i] = std::llrint(x_win * double(kSubPixelScale));
+        fy[i] = std::llrint(y_win * double(kSubPixelScale));
+        z[i] = float((double(clip[i][2]) / w + 1.0) * 0.5);
+        inv_w[i] = float(1.0 / w);
+    }
+
+    // Twice the signed area, exact. Front faces wind counter-clockwise in NDC
+    // (y up), which is a negative area in window space (y down).
+    std::int64_t area2 = (fx[1] - fx[0]) * (fy[2] - fy[0]) - (fx[2] - fx[0]) * (fy[1] - fy[0]);
+    if (area2 == 0) return SetupResult::Degenerate;
+    bool front = area2 < 0;
+    if (!front && cull_back) return SetupResult::CulledBack;
+
+    // Order the vertices so that the area is positive: then every edge function
+    // is >= 0 inside, whichever face we look at.
+    int order[3] = {0, 1, 2};
+    if (front) {
+        std::swap(order[1], order[2]);
+        area2 = -area2;
+    }
+    std::int64_t X[3], Y[3];
+    for (int i = 0; i < 3; ++i) {
+        X[i] = fx[order[i]];
+        Y[i] = fy[order[i]];
+        t.z[i] = z[order[i]];
+        t.inv_w[i] = inv_w[order[i]];
+        t.vtx[i] = ref[order[i]];
+    }
+    t.front_facing = front;
+
+    // Pixel box: pixel i is a candidate when its centre i*256+128 lies within
+    // the vertices' extent. Arithmetic shifts floor negatives correctly.
+    std::int64_t lo_x = std::min({X[0], X[1], X[2]}), hi_x = std::max({X[0], X[1], X[2]});
+    std::int64_t lo_y = std::min({Y[0], Y[1], Y[2]}), hi_y = std::max({Y[0], Y[1], Y[2]});
+    std::int64_t minx = (lo_x - kHalfPixel + kSubPixelScale - 1) >> kSubPixelBits;
+    std::int64_t maxx = (hi_x - kHalfPixel) >> kSubPixelBits;
+    std::int64_t miny = (lo_y - kHalfPixel + kSubPixelScale - 1) >> kSubPixelBits;
+    std::int64_t maxy = (hi_y - kHalfPixel) >> kSubPixelBits;
+    minx = std::max<std::int64_t>(minx, 0);
+    miny = std::max<std::int64_t>(miny, 0);
+    maxx = std::min<std::int64_t>(maxx, width - 1);
+    maxy = std::min<std::int64_t>(maxy, height - 1);
+    if (minx > maxx || miny > maxy) return SetupResult::Degenerate;
+    t.minx = int(minx); t.miny = int(miny); t.maxx = int(maxx); t.maxy = int(maxy);
+
+    // Edge functions. Edge i runs from vertex i+1 to vertex i+2:
+    //   E(p) = (bx - ax)(py - ay) - (by - ay)(px - ax) = A px + B py + C.
+    // Top-left rule (y down, positive area): a top edge is horizontal with
+    // bx > ax; a left edge goes up (by < ay). Others exclude centres exactly on
+    // them, which for integers is E - 1 >= 0.
+    double anchor_x = double(minx * kSubPixelScale + kHalfPixel);
+    double anchor_y = double(miny * kSubPixelScale + kHalfPixel);
+    double inv_area2 = 1.0 / double(area2);
+    for (int e = 0; e < 3; ++e) {
+        int a = (e + 1) % 3, b = (e + 2) % 3;
+        std::int64_t A = Y[a] - Y[b];
+        std::int64_t B = X[b] - X[a];
+        std::int64_t C = -(A * X[a] + B * Y[a]);
+        bool top = A == 0 && B > 0;
+        bool left = A > 0;
+        t.A[e] = std::int32_t(A);
+        t.B[e] = std::int32_t(B);
+        t.C[e] = (top || left) ? C : C - 1;
+        // Barycentric plane of the opposite vertex, from the unbiased function.
+        double at_anchor = double(A) * anchor_x + double(B) * anchor_y + double(C);
+        t.bary[e][0] = float(at_anchor * inv_area2);
+        t.bary[e][1] = float(double(A * kSubPixelScale) * inv_area2);
+        t.bary[e][2] = float(double(B * kSubPixelScale) * inv_area2);
+    }
+    return SetupResult::Ok;
+}
+
+} // namespace prast
