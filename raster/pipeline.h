@@ -41,8 +41,11 @@ public:
     ThreadPool& pool() { return pool_; }
 
     // Counters accumulate over draws until the next begin_frame().
-    void begin_frame() { stats_ = FrameStats{}; }
+    void begin_frame() { stats_ = FrameStats{}; tile_entries_.clear(); }
     const FrameStats& stats() const { return stats_; }
+    // Bin entries per tile over this frame's draws (row-major tiles of the
+    // last framebuffer size): the `tiles` debug view and the stepper show it.
+    const std::vector<std::uint32_t>& tile_entries() const { return tile_entries_; }
 
     // Draws an indexed triangle list (index_count / 3 triangles). Indices out of
     // range and non-finite positions drop their triangle (counted as invalid).
@@ -74,6 +77,7 @@ private:
     std::vector<float> vertices_;          // post-vertex-shader, reused across draws
     std::vector<BinJob> jobs_;
     std::vector<FrameStats> worker_stats_;
+    std::vector<std::uint32_t> tile_entries_;
     FrameStats stats_;
 };
 
@@ -215,7 +219,13 @@ void Renderer::draw(Framebuffer& fb, const Program& program, std::uint32_t verte
     // Tiles: each tile is owned by one thread, its bins run in submission order.
     t0 = Clock::now();
     TileContext ctx{&fb, &grid, &state, vertices_.data(), jobs_.data(), job_count, stride};
+    if (tile_entries_.size() != std::size_t(grid.count())) tile_entries_.assign(std::size_t(grid.count()), 0);
     pool_.run(grid.count(), [&](int tile, int worker) {
+        std::uint32_t entries = 0;
+        for (int j = 0; j < job_count; ++j)
+            entries += jobs_[std::size_t(j)].tile_offsets[tile + 1] - jobs_[std::size_t(j)].tile_offsets[tile];
+        tile_entries_[std::size_t(tile)] += entries;
+        if (entries == 0) return;
         rasterize_tile<Program, Observer>(program, ctx, tile, worker_stats_[std::size_t(worker)], obs);
     });
     for (const FrameStats& ws : worker_stats_) stats_.add_counters(ws);

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -16,6 +17,8 @@
 #include <glm/glm.hpp>
 
 namespace prast {
+
+struct Image;  // texture.h
 
 // A bad input file: what() is one line, "FILE: problem".
 struct LoadError : std::runtime_error {
@@ -28,6 +31,8 @@ struct ImageSource {
     std::string path;                 // file path, empty when embedded
     std::vector<unsigned char> bytes; // embedded encoded bytes (PNG/JPEG)
     std::string name;                 // for messages: path or "file.glb#image3"
+    // Procedural images (the built-in scene) arrive decoded, already linear.
+    std::shared_ptr<const Image> decoded;
 };
 
 enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };

@@ -1,0 +1,162 @@
+// Texture binding and frame rendering for a Scene; see scene_renderer.h.
+#include "shading/scene_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+namespace prast {
+
+std::vector<ShadingLight> shading_lights(const Scene& scene) {
+    std::vector<ShadingLight> out;
+    for (const Light& L : scene.lights) {
+        ShadingLight s;
+        s.point = L.type == Light::Type::Point;
+        float len = glm::length(L.direction);
+        s.direction = len > 0.0f ? L.direction / len : glm::vec3(0.0f, 1.0f, 0.0f);
+        s.position = L.position;
+        s.radiance = L.color * L.intensity;
+        out.push_back(s);
+    }
+    return out;
+}
+
+std::vector<ShadingLight> default_light_rig() {
+    ShadingLight key, fill;
+    key.direction = glm::normalize(glm::vec3(-0.5f, 0.8f, 0.6f));
+    key.radiance = glm::vec3(3.0f, 2.9f, 2.7f);
+    fill.direction = glm::normalize(glm::vec3(0.7f, 0.3f, 0.4f));
+    fill.radiance = glm::vec3(0.6f, 0.7f, 0.9f);
+    return {key, fill};
+}
+
+SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(scene), renderer_(renderer) {
+    // Which (image, colour space) pairs the materials need.
+    const std::size_t n_images = scene.images.size();
+    std::vector<char> needed(n_images * 2, 0);
+    auto want = [&](const TextureRef& r, bool srgb) {
+        if (r.valid() && std::size_t(r.image) < n_images) needed[std::size_t(r.image) * 2 + srgb] = 1;
+    };
+    for (const Material& m : scene.materials) {
+        want(m.base_color, true);
+        want(m.emissive, true);
+        want(m.metallic_roughness, false);
+        want(m.roughness, false);
+        want(m.metallic, false);
+        want(m.normal, false);
+        want(m.occlusion, false);
+    }
+    // Decode in parallel; each task owns its slot, so the result is the same
+    // for any thread count. Failures become warnings in image order.
+    textures_.resize(needed.size());
+    std::vector<std::string> errors(needed.size());
+    std::vector<int> slots;
+    for (std::size_t i = 0; i < needed.size(); ++i)
+        if (needed[i]) slots.push_back(int(i));
+    renderer.pool().run(int(slots.size()), [&](int task, int) {
+        std::size_t slot = std::size_t(slots[std::size_t(task)]);
+        const ImageSource& src = scene.images[slot / 2];
+        bool srgb = slot % 2 == 1;
+        try {
+            Image img = src.decoded ? *src.decoded : decode_image(src, srgb);
+            // Wrap modes live on the reference; the first user's are used.
+            Wrap ws = Wrap::Repeat, wt = Wrap::Repeat;
+            for (const Material& m : scene.materials)
+                for (const TextureRef* r : {&m.base_color, &m.emissive, &m.metallic_roughness, &m.roughness,
+                                            &m.metallic, &m.normal, &m.occlusion})
+                    if (std::size_t(r->image) == slot / 2) { ws = r->wrap_s; wt = r->wrap_t; }
+            textures_[slot] = std::make_unique<Texture>(Texture::from_image(std::move(img), ws, wt));
+        } catch (const std::exception& e) {
+            errors[slot] = e.what();
+        }
+    });
+    for (const std::string& e : errors)
+        if (!e.empty()) warnings_.push_back(e + " (texture ignored)");
+
+    auto bind = [&](const TextureRef& r, bool srgb) -> const Texture* {
+        if (!r.valid() || std::size_t(r.image) >= n_images) return nullptr;
+        return textures_[std::size_t(r.image) * 2 + srgb].get();
+    };
+    for (const Material& m : scene.materials) {
+        BoundMaterial b;
+        b.m = &m;
+        b.base_color = bind(m.base_color, true);
+        b.emissive = bind(m.emissive, true);
+        b.metallic_roughness = bind(m.metallic_roughness, false);
+        b.roughness = bind(m.roughness, false);
+        b.metallic = bind(m.metallic, false);
+        b.normal = bind(m.normal, false);
+        b.occlusion = bind(m.occlusion, false);
+        bound_.push_back(b);
+    }
+}
+
+void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb) {
+    fb.clear(0.0f, 0.0f, 0.0f, 1.0f);
+    renderer_.begin_frame();
+    ShadingContext ctx;
+    ctx.eye = s.camera.eye;
+    ctx.lights = s.lights;
+    ctx.ambient = s.ambient;
+    ctx.model = s.model;
+    const float aspect = float(fb.width) / float(fb.height);
+    const glm::mat4 vp = s.camera.view_projection(aspect);
+    static const Material kFallback;
+    static const BoundMaterial kFallbackBound{&kFallback};
+    for (const Mesh& mesh : scene_.meshes) {
+        if (mesh.indices.empty()) continue;
+        const BoundMaterial* bm = mesh.material >= 0 && std::size_t(mesh.material) < bound_.size()
+                                      ? &bound_[std::size_t(mesh.material)] : &kFallbackBound;
+        PbrProgram prog;
+        prog.mesh = &mesh;
+        prog.view_proj = vp;
+        prog.material = bm;
+        prog.ctx = &ctx;
+        prog.view = s.view;
+        prog.near_plane = s.camera.near_plane;
+        prog.far_plane = s.camera.far_plane;
+        DrawState st;
+        st.cull = bm->m->double_sided ? CullMode::None : CullMode::Back;
+        if (s.view == DebugView::Overdraw) {
+            st.blend = Blend::Add;
+            st.depth_test = false;
+            st.depth_write = false;
+        }
+        renderer_.draw(fb, prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(), mesh.indices.size(), st);
+    }
+    if (s.view == DebugView::Overdraw) apply_overdraw_heat(fb);
+    if (s.view == DebugView::Tiles) apply_tile_overlay(fb, renderer_.tile_entries(), renderer_.tile_size());
+}
+
+// Fragments per pixel (in red, counted additively) to a heat ramp:
+// 0 black, 1 blue, 2 green, 3 yellow, 4 red, 8+ white.
+void apply_overdraw_heat(Framebuffer& fb) {
+    static const glm::vec3 kRamp[] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0},
+                                      {1, 0, 1}, {1, 0.5f, 1}, {1, 0.8f, 1}, {1, 1, 1}};
+    for (std::size_t i = 0; i < fb.color.size(); i += 4) {
+        int n = std::min(8, int(fb.color[i]));
+        fb.color[i] = kRamp[n].r; fb.color[i + 1] = kRamp[n].g; fb.color[i + 2] = kRamp[n].b;
+        fb.color[i + 3] = 1.0f;
+    }
+}
+
+// Tinted tiles by bin entries (log scale, blue few to red many) over the lit
+// image, with the tile borders drawn.
+void apply_tile_overlay(Framebuffer& fb, const std::vector<std::uint32_t>& entries, int tile_size) {
+    int tiles_x = (fb.width + tile_size - 1) / tile_size;
+    std::uint32_t most = 1;
+    for (std::uint32_t e : entries) most = std::max(most, e);
+    for (int y = 0; y < fb.height; ++y)
+        for (int x = 0; x < fb.width; ++x) {
+            std::size_t t = std::size_t(y / tile_size) * tiles_x + x / tile_size;
+            float heat = t < entries.size() && entries[t] > 0
+                             ? float(std::log2(1.0 + entries[t]) / std::log2(1.0 + most)) : 0.0f;
+            float* c = fb.pixel(x, y);
+            glm::vec3 tint = glm::mix(glm::vec3(0.1f, 0.2f, 1.0f), glm::vec3(1.0f, 0.15f, 0.05f), heat);
+            bool border = x % tile_size == 0 || y % tile_size == 0;
+            float k = entries.size() > t && entries[t] ? 0.35f : 0.0f;
+            for (int ch = 0; ch < 3; ++ch) c[ch] = border ? 1.0f : c[ch] * (1.0f - k) + tint[ch] * k;
+        }
+}
+
+} // namespace prast
