@@ -1,0 +1,210 @@
+// Textures: decoding image files to linear float RGBA (stb_image), the
+// box-filtered mip chain, and the bilinear / trilinear samplers the shaders call
+// per pixel. Also the procedural images of the built-in default scene.
+//
+// Conventions (conventions.md, "Textures"): texel centres at (i + 0.5) / width,
+// v = 0 is the TOP row of the image (the project's internal UVs; no flipping
+// here), lambda = log2(max(|d(uv * size)/dx|, |d(uv * size)/dy|)) with level-0
+// sizes, as the OpenGL specification writes it (no anisotropy). Filtering and
+// mip generation happen in linear space: sRGB images are decoded on load.
+//
+// A Texture is immutable after construction and is shared read-only between
+// render threads: no caches, no allocation and no virtual calls when sampling.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "shading/scene.h"
+
+namespace prast {
+
+// Linear float RGBA, 4 floats per texel, row-major, row 0 = top row of the file.
+struct Image {
+    int width = 0, height = 0;
+    std::vector<float> rgba;
+
+    bool empty() const { return width <= 0 || height <= 0; }
+    glm::vec4 at(int x, int y) const {
+        const float* p = &rgba[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4];
+        return {p[0], p[1], p[2], p[3]};
+    }
+    void set(int x, int y, const glm::vec4& c) {
+        float* p = &rgba[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4];
+        p[0] = c.r; p[1] = c.g; p[2] = c.b; p[3] = c.a;
+    }
+};
+
+// Images larger than this are refused before anything is allocated: 2^28
+// texels is 4 GiB as float RGBA, far beyond any sane texture.
+constexpr std::int64_t kMaxImageTexels = std::int64_t(1) << 28;
+
+// Decodes src.bytes when not empty, else the file src.path (PNG, JPEG, HDR and
+// whatever else stb_image reads). 8-bit and 16-bit colour channels are sRGB-
+// decoded when `srgb` (alpha never is), else scaled to [0, 1]; HDR (Radiance)
+// data is linear and kept as is. Grey -> (g, g, g, 1), grey+alpha -> (g, g, g, a),
+// RGB -> (r, g, b, 1). Throws LoadError "NAME: reason" (NAME = src.name, or the
+// path) for a missing, unreadable, empty, corrupt, zero-sized or oversized image.
+Image decode_image(const ImageSource& src, bool srgb);
+
+class Texture {
+public:
+    static constexpr int kMaxLevels = 32;
+
+    // A 1x1 opaque white texture, so that a default Texture samples safely.
+    Texture();
+
+    // Builds the full mip chain (level k+1 = level k halved, rounded down, at
+    // least 1) with an area-weighted box filter: even sizes average 2 texels
+    // per axis; an odd size n = 2m + 1 gives m texels that each cover n / m
+    // source texels, i.e. 3 taps weighted (m - i, m, i + 1) / n for output i.
+    // Every source texel gives away exactly its area, so the mean of each level
+    // equals the mean of level 0 (up to float rounding).
+    // Throws std::invalid_argument for an empty image or a wrong rgba size.
+    static Texture from_image(Image img, Wrap s = Wrap::Repeat, Wrap t = Wrap::Repeat);
+
+    int levels() const { return level_count_; }
+    int width(int level) const { return levels_[clamp_level(level)].width; }
+    int height(int level) const { return levels_[clamp_level(level)].height; }
+    Wrap wrap_s() const { return wrap_s_; }
+    Wrap wrap_t() const { return wrap_t_; }
+
+    // One stored texel; the level and coordinates are clamped to the valid range.
+    glm::vec4 texel(int level, int x, int y) const;
+    // The mean colour of the image: the last (1x1) level.
+    glm::vec4 average() const { return texel(level_count_ - 1, 0, 0); }
+
+    // lambda = log2(rho), rho = max(sqrt((dudx w)^2 + (dvdx h)^2),
+    // sqrt((dudy w)^2 + (dvdy h)^2)) with the level-0 size w x h. The result is
+    // finite: clamped to [-64, 64] (zero derivatives give -64), NaN gives 0.
+    float lod(float dudx, float dvdx, float dudy, float dvdy) const;
+
+    // Bilinear filter of one level (clamped to the valid range).
+    glm::vec4 sample_bilinear(float u, float v, int level) const;
+    // lambda <= 0 (or NaN): bilinear on level 0 (magnification). Otherwise a
+    // linear blend of the bilinear results of levels floor(lambda) and
+    // floor(lambda) + 1, clamped to the last level.
+    glm::vec4 sample_trilinear(float u, float v, float lambda) const;
+    // sample_trilinear(u, v, lod(...)).
+    glm::vec4 sample(float u, float v, float dudx, float dvdx, float dudy, float dvdy) const {
+        return sample_trilinear(u, v, lod(dudx, dvdx, dudy, dvdy));
+    }
+
+private:
+    struct Level {
+        int width = 0, height = 0;
+        float fwidth = 0.0f, fheight = 0.0f;
+        std::size_t offset = 0;  // first texel in texels_
+    };
+
+    int clamp_level(int level) const {
+        return level < 0 ? 0 : (level >= level_count_ ? level_count_ - 1 : level);
+    }
+    static float reduce(float c, Wrap wrap);
+    static int wrap_index(int i, int n, Wrap wrap);
+    glm::vec4 bilinear_reduced(float u, float v, int level) const;
+
+    std::vector<glm::vec4> texels_;  // all levels, level 0 first, row-major
+    Level levels_[kMaxLevels];
+    int level_count_ = 0;
+    Wrap wrap_s_ = Wrap::Repeat, wrap_t_ = Wrap::Repeat;
+};
+
+// ---- Procedural images (linear values, deterministic, seamless under Repeat).
+
+// size x size, cells x cells squares; the top-left cell is `a`.
+Image make_checker(int size, int cells, glm::vec4 a, glm::vec4 b);
+// Running-bond bricks (4 across, 8 rows per tile of the texture) in a palette
+// of ceramic colours, a few of them gold, with grey grout. Linear colour.
+Image make_tiles_albedo(int size);
+// The matching tangent-space normal map (OpenGL convention: green points up
+// the image, towards -v), encoded 0.5 * n + 0.5: bevelled brick edges,
+// concave grout grooves, each brick slightly tilted.
+Image make_tiles_normal(int size);
+// ORM packing: R = ambient occlusion (grout darker), G = roughness (glazed
+// bricks smooth-ish, grout rough), B = metallic (1 on the gold bricks).
+Image make_tiles_roughness_metal(int size);
+
+// ---- Inline sampling (the per-pixel hot path).
+
+// Folds a texture coordinate into one period of its wrap mode, so that the
+// texel index computed from it stays in [-1, 2 * size] and converts to int
+// safely: Repeat -> [0, 1], MirroredRepeat -> [0, 2], ClampToEdge -> [0, 1]
+// (clamping u to [0, 1] gives the same texels as clamping the index).
+// NaN and +-Inf become 0.
+inline float Texture::reduce(float c, Wrap wrap) {
+    if (!(std::fabs(c) <= 3.402823466e38f)) c = 0.0f;  // NaN or Inf
+    switch (wrap) {
+    case Wrap::Repeat: return c - std::floor(c);
+    case Wrap::MirroredRepeat: return c - 2.0f * std::floor(c * 0.5f);
+    case Wrap::ClampToEdge: break;
+    }
+    return c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
+}
+
+// Maps a texel index in [-1, 2n] (guaranteed by reduce()) into [0, n).
+inline int Texture::wrap_index(int i, int n, Wrap wrap) {
+    switch (wrap) {
+    case Wrap::Repeat:
+        if (i < 0) return i + n;
+        return i >= n ? i - n : i;
+    case Wrap::MirroredRepeat:
+        if (i < 0) i = -1 - i;         // mirror image of -1 is 0
+        if (i >= 2 * n) i -= 2 * n;    // period 2n
+        return i >= n ? 2 * n - 1 - i : i;
+    case Wrap::ClampToEdge: break;
+    }
+    return i < 0 ? 0 : (i >= n ? n - 1 : i);
+}
+
+inline glm::vec4 Texture::bilinear_reduced(float u, float v, int level) const {
+    const Level& L = levels_[level];
+    // Texel centres at (i + 0.5) / size.
+    const float x = u * L.fwidth - 0.5f, y = v * L.fheight - 0.5f;
+    const float fx = std::floor(x), fy = std::floor(y);
+    const float tx = x - fx, ty = y - fy;
+    const int x0 = int(fx), y0 = int(fy);
+    const int xa = wrap_index(x0, L.width, wrap_s_), xb = wrap_index(x0 + 1, L.width, wrap_s_);
+    const int ya = wrap_index(y0, L.height, wrap_t_), yb = wrap_index(y0 + 1, L.height, wrap_t_);
+    const glm::vec4* base = texels_.data() + L.offset;
+    const glm::vec4* row_a = base + std::size_t(ya) * std::size_t(L.width);
+    const glm::vec4* row_b = base + std::size_t(yb) * std::size_t(L.width);
+    // a + (b - a) t: exact at t = 0 and wherever a == b (a constant texture
+    // samples to exactly its value).
+    const glm::vec4 top = row_a[xa] + (row_a[xb] - row_a[xa]) * tx;
+    const glm::vec4 bottom = row_b[xa] + (row_b[xb] - row_b[xa]) * tx;
+    return top + (bottom - top) * ty;
+}
+
+inline glm::vec4 Texture::sample_bilinear(float u, float v, int level) const {
+    return bilinear_reduced(reduce(u, wrap_s_), reduce(v, wrap_t_), clamp_level(level));
+}
+
+inline glm::vec4 Texture::sample_trilinear(float u, float v, float lambda) const {
+    const float ur = reduce(u, wrap_s_), vr = reduce(v, wrap_t_);
+    if (!(lambda > 0.0f)) return bilinear_reduced(ur, vr, 0);  // magnification, or NaN
+    const int last = level_count_ - 1;
+    if (lambda >= float(last)) return bilinear_reduced(ur, vr, last);
+    const float fl = std::floor(lambda);  // in [0, last): the int conversion is safe
+    const int l0 = int(fl);
+    const float t = lambda - fl;
+    const glm::vec4 a = bilinear_reduced(ur, vr, l0);
+    if (t == 0.0f) return a;
+    return a + (bilinear_reduced(ur, vr, l0 + 1) - a) * t;
+}
+
+inline float Texture::lod(float dudx, float dvdx, float dudy, float dvdy) const {
+    const float w = levels_[0].fwidth, h = levels_[0].fheight;
+    const float ax = dudx * w, bx = dvdx * h, ay = dudy * w, by = dvdy * h;
+    // log2(rho) = 0.5 log2(rho^2): saves both square roots.
+    const float rho2 = std::fmax(ax * ax + bx * bx, ay * ay + by * by);
+    const float lambda = 0.5f * std::log2(rho2);
+    if (lambda != lambda) return 0.0f;  // NaN derivatives
+    return lambda < -64.0f ? -64.0f : (lambda > 64.0f ? 64.0f : lambda);
+}
+
+} // namespace prast
