@@ -3,7 +3,10 @@
 // prints the median, minimum and maximum frame time and megapixels per second
 // (width * height / median). Timing belongs here, never in unit tests.
 //
-//   bench [SCENE] [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME]
+//   bench [SCENE] [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME] [--flat]
+//
+// --flat replaces the PBR program by a one-light Lambert program without
+// textures, which measures the pipeline itself rather than the shading.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -28,6 +31,37 @@ std::vector<int> parse_list(const std::string& s) {
     return out;
 }
 
+// Lambert with one fixed light, no textures: the cost of the core.
+struct FlatProgram {
+    static constexpr int kVaryings = 3;
+    const Mesh* mesh = nullptr;
+    glm::mat4 view_proj{1.0f};
+    void vertex(std::uint32_t i, float clip[4], float* var) const {
+        glm::vec4 c = view_proj * glm::vec4(mesh->positions[i], 1.0f);
+        clip[0] = c.x; clip[1] = c.y; clip[2] = c.z; clip[3] = c.w;
+        var[0] = mesh->normals[i].x; var[1] = mesh->normals[i].y; var[2] = mesh->normals[i].z;
+    }
+    void fragment(const FragmentBlock<3>& in, FragmentOut& out) const {
+        for (int l = 0; l < kBlockLanes; ++l) {
+            float ndl = in.var[0][l] * -0.4f + in.var[1][l] * 0.7f + in.var[2][l] * 0.6f;
+            float c = 0.03f + 0.8f * (ndl > 0.0f ? ndl : 0.0f);
+            out.r[l] = c; out.g[l] = c; out.b[l] = c; out.a[l] = 1.0f;
+        }
+    }
+};
+
+double render_flat(Renderer& renderer, const Scene& scene, const Camera& cam, Framebuffer& fb) {
+    auto t0 = std::chrono::steady_clock::now();
+    fb.clear(0, 0, 0, 1);
+    renderer.begin_frame();
+    glm::mat4 vp = cam.view_projection(float(fb.width) / float(fb.height));
+    for (const Mesh& m : scene.meshes) {
+        FlatProgram p{&m, vp};
+        renderer.draw(fb, p, std::uint32_t(m.positions.size()), m.indices.data(), m.indices.size());
+    }
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 int usage() {
     std::fprintf(stderr, "usage: bench [SCENE] [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME]\n");
     return 2;
@@ -40,6 +74,7 @@ int main(int argc, char** argv) {
     int width = 1920, height = 1080, repeat = 15;
     std::vector<int> threads = {1, 2}, tiles = {kDefaultTileSize};
     DebugView view = DebugView::None;
+    bool flat = false;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -51,6 +86,7 @@ int main(int argc, char** argv) {
         else if (a == "--tiles") tiles = parse_list(next());
         else if (a == "--repeat") repeat = std::max(1, std::atoi(next().c_str()));
         else if (a == "--view") { if (!parse_debug_view(next(), view)) return usage(); }
+        else if (a == "--flat") flat = true;
         else if (!a.empty() && a[0] == '-') return usage();
         else scene_path = a;
     }
@@ -78,9 +114,9 @@ int main(int argc, char** argv) {
     lights = shading_lights(*scene);
     if (lights.empty()) lights = default_light_rig();
 
-    std::printf("scene %s, %zu triangles, %dx%d, %d frames per configuration\n",
+    std::printf("scene %s, %zu triangles, %dx%d, %d frames per configuration, %s program\n",
                 scene_path.empty() ? "(built-in)" : scene_path.c_str(), scene->triangle_count(), width,
-                height, repeat);
+                height, repeat, flat ? "flat Lambert" : "PBR");
     for (int tile : tiles)
         for (int t : threads) {
             Renderer renderer({t, tile});
@@ -90,13 +126,19 @@ int main(int argc, char** argv) {
             fs.lights = lights;
             fs.view = view;
             Framebuffer fb(width, height);
-            sr.render(fs, fb);  // warm-up: page in the framebuffer and bins
+            // The first frame is a warm-up: it pages in the framebuffer and bins.
             std::vector<double> ms;
             FrameStats last;
-            for (int r = 0; r < repeat; ++r) {
-                auto t0 = std::chrono::steady_clock::now();
-                sr.render(fs, fb);
-                ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            for (int r = 0; r <= repeat; ++r) {
+                double t;
+                if (flat) {
+                    t = render_flat(renderer, *scene, camera, fb);
+                } else {
+                    auto t0 = std::chrono::steady_clock::now();
+                    sr.render(fs, fb);
+                    t = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+                }
+                if (r > 0) ms.push_back(t);
                 last = renderer.stats();
             }
             std::sort(ms.begin(), ms.end());
