@@ -55,10 +55,15 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
     }
     const Material& m = *material->m;
     const bool alpha_mask = m.alpha_mode == AlphaMode::Mask;
+    MaterialLods lods;
     for (int l = 0; l < kBlockLanes; ++l) {
         if (!(in.mask & (1u << l))) continue;
         SurfacePoint sp = surface_point(in, l);
-        MaterialSample ms = sample_material(*material, sp);
+        // The quad's lanes share derivatives, hence levels of detail: compute
+        // them at the first live lane of each quad.
+        if (!(in.mask & (0xFu << (l & ~3)) & ((1u << l) - 1)))
+            lods = material_lods(*material, sp.duv_dx, sp.duv_dy);
+        MaterialSample ms = sample_material(*material, sp, lods);
         if (alpha_mask && !(ms.alpha >= m.alpha_cutoff)) {
             out.kill |= 1u << l;
             continue;
