@@ -2,6 +2,8 @@
 // over lanes lives here so that sample_material/shade_surface inline into it.
 #include "shading/pbr_program.h"
 
+#include "shading/light_block.h"
+
 #include <cmath>
 
 namespace prast {
@@ -50,13 +52,23 @@ BrdfTerms first_light_terms(const MaterialSample& ms, const SurfacePoint& sp, co
 } // namespace
 
 void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
-    for (int l = 0; l < kBlockLanes; ++l) {
-        out.r[l] = 0.0f; out.g[l] = 0.0f; out.b[l] = 0.0f; out.a[l] = 1.0f;
-    }
     const Material& m = *material->m;
     const bool alpha_mask = m.alpha_mode == AlphaMode::Mask;
+    // The lit path batches the lighting of all lanes (light_block.h); debug
+    // views and conductor materials shade lane by lane.
+    const bool batched = (view == DebugView::None || view == DebugView::Tiles) && m.conductor == Conductor::None;
+    MaterialBlock mb;
     MaterialLods lods;
     for (int l = 0; l < kBlockLanes; ++l) {
+        out.r[l] = 0.0f; out.g[l] = 0.0f; out.b[l] = 0.0f; out.a[l] = 1.0f;
+        if (batched) {
+            // Dead lanes get harmless inputs; their results are never written.
+            mb.Px[l] = in.var[kVarP][l]; mb.Py[l] = in.var[kVarP + 1][l]; mb.Pz[l] = in.var[kVarP + 2][l];
+            mb.Nx[l] = 0.0f; mb.Ny[l] = 0.0f; mb.Nz[l] = 1.0f;
+            mb.ar[l] = mb.ag[l] = mb.ab[l] = 0.0f;
+            mb.metallic[l] = 0.0f; mb.roughness[l] = 1.0f; mb.occlusion[l] = 1.0f;
+            mb.er[l] = mb.eg[l] = mb.eb[l] = 0.0f;
+        }
         if (!(in.mask & (1u << l))) continue;
         SurfacePoint sp = surface_point(in, l);
         // The quad's lanes share derivatives, hence levels of detail: compute
@@ -66,6 +78,14 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
         MaterialSample ms = sample_material(*material, sp, lods);
         if (alpha_mask && !(ms.alpha >= m.alpha_cutoff)) {
             out.kill |= 1u << l;
+            continue;
+        }
+        if (batched) {
+            mb.Nx[l] = ms.N.x; mb.Ny[l] = ms.N.y; mb.Nz[l] = ms.N.z;
+            mb.ar[l] = ms.albedo.r; mb.ag[l] = ms.albedo.g; mb.ab[l] = ms.albedo.b;
+            mb.metallic[l] = ms.metallic; mb.roughness[l] = ms.roughness; mb.occlusion[l] = ms.occlusion;
+            mb.er[l] = ms.emissive.r; mb.eg[l] = ms.emissive.g; mb.eb[l] = ms.emissive.b;
+            mb.ior = ms.ior;
             continue;
         }
         glm::vec3 c;
@@ -94,7 +114,13 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
         case DebugView::Specular: c = sum_lobes(ms, sp, *ctx, true); break;
         }
         out.r[l] = c.r; out.g[l] = c.g; out.b[l] = c.b;
-        out.a[l] = 1.0f;
+    }
+    if (batched) {
+        RadianceBlock rb;
+        shade_block_lanes(mb, *ctx, rb);
+        for (int l = 0; l < kBlockLanes; ++l) {
+            out.r[l] = rb.r[l]; out.g[l] = rb.g[l]; out.b[l] = rb.b[l];
+        }
     }
 }
 
