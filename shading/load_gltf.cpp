@@ -1,0 +1,869 @@
+// glTF 2.0 (.gltf and .glb) through tinygltf, flattened into world-space meshes.
+//
+// tinygltf parses the JSON and loads buffers; it does not check accessors,
+// buffer views, node graphs or most indices, so everything read here is
+// checked first (a corrupt file is a LoadError, a missing texture a warning).
+// Two defects of tinygltf 2.7.0 are worked around before it sees the data:
+//  - a .glb whose BIN chunk claims up to 8 bytes more than the file holds is
+//    read past its end (the chunk header is not counted): the GLB layout is
+//    validated here first;
+//  - an image in a bufferView is handed to the image callback without checking
+//    byteOffset/byteLength against the buffer: the callback ignores those bytes
+//    and they are copied here after a bounds check.
+// Images are never decoded here (tinygltf is built without stb_image).
+#include "shading/load_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <utility>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_INCLUDE_STB_IMAGE
+#define TINYGLTF_NO_INCLUDE_STB_IMAGE_WRITE
+#include <tiny_gltf.h>
+
+namespace prast {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Deeper JSON is refused before parsing: nlohmann::json and tinygltf's
+// conversion of extensions both recurse once per level.
+constexpr int kMaxJsonDepth = 256;
+// No accessor may claim more elements than this (2^31 - 1).
+constexpr std::size_t kMaxAccessorCount = 0x7fffffff;
+
+// ---- Callbacks handed to tinygltf
+
+// Keeps the encoded bytes of data-URI images only. External files are kept as
+// paths (texture.h reads them), and bufferView images are copied after a bounds
+// check that tinygltf 2.7.0 does not do (see the file comment).
+bool keep_encoded_image(tinygltf::Image* image, const int /*image_idx*/, std::string* /*err*/,
+                        std::string* /*warn*/, int /*req_width*/, int /*req_height*/,
+                        const unsigned char* bytes, int size, void* /*user*/) {
+    if (image->bufferView < 0 && image->uri.empty() && bytes && size > 0)
+        image->image.assign(bytes, bytes + size);
+    return true;
+}
+
+// tinygltf's reader, bounded: only regular files (a FIFO or device named by a
+// URI would block), at most kMaxFileBytes.
+bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                     void* /*user*/) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) {
+        if (err) *err += "not a regular file: " + path;
+        return false;
+    }
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (ec || size > detail::kMaxFileBytes) {
+        if (err) *err += "cannot read or too large: " + path;
+        return false;
+    }
+    std::ifstream in(path, std::ios::binary);
+    out->resize(std::size_t(size));
+    in.read(reinterpret_cast<char*>(out->data()), std::streamsize(out->size()));
+    if (!in && !out->empty()) {
+        if (err) *err += "read error: " + path;
+        return false;
+    }
+    return true;
+}
+
+bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err += "writing is disabled";
+    return false;
+}
+
+// ---- Pre-checks of the raw bytes
+
+std::uint32_t le32(const unsigned char* p) {
+    return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 |
+           std::uint32_t(p[3]) << 24;
+}
+
+// Checks the GLB header and chunk layout; returns the length tinygltf may read.
+std::size_t check_glb(const std::vector<unsigned char>& b, const std::string& path) {
+    if (b.size() < 20) throw LoadError(path + ": truncated .glb header");
+    if (std::memcmp(b.data(), "glTF", 4) != 0) throw LoadError(path + ": not a binary glTF (bad magic)");
+    const std::uint32_t version = le32(&b[4]), length = le32(&b[8]);
+    const std::uint64_t json_length = le32(&b[12]);
+    if (version != 2)
+        throw LoadError(path + ": unsupported binary glTF version " + std::to_string(version));
+    if (length > b.size())
+        throw LoadError(path + ": truncated .glb (header says " + std::to_string(length) +
+                        " bytes, file has " + std::to_string(b.size()) + ")");
+    if (length < 20 || 20 + json_length > length || json_length == 0)
+        throw LoadError(path + ": bad .glb JSON chunk length");
+    if (le32(&b[16]) != 0x4E4F534A) throw LoadError(path + ": .glb does not start with a JSON chunk");
+    const std::uint64_t bin = 20 + json_length;
+    if (bin < length) {
+        if (bin + 8 > length) throw LoadError(path + ": truncated .glb chunk header");
+        const std::uint64_t bin_length = le32(&b[std::size_t(bin)]);
+        if (bin + 8 + bin_length > length)
+            throw LoadError(path + ": .glb BIN chunk longer than the file");
+    }
+    return length;
+}
+
+// Refuses JSON nested deeper than kMaxJsonDepth (strings are skipped).
+void check_json_depth(const char* s, std::size_t n, const std::string& path) {
+    int depth = 0;
+    bool in_string = false;
+    for (std::size_t i = 0; i < n; ++i) {
+        const char c = s[i];
+        if (in_string) {
+            if (c == '\\') ++i;
+            else if (c == '"') in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '{' || c == '[') {
+            if (++depth > kMaxJsonDepth) throw LoadError(path + ": JSON nested too deeply");
+        } else if (c == '}' || c == ']') {
+            --depth;
+        }
+    }
+}
+
+std::string first_line(const std::string& s, const char* fallback) {
+    const std::size_t begin = s.find_first_not_of(" \t\r\n");
+    if (begin == std::string::npos) return fallback;
+    const std::size_t end = s.find_first_of("\r\n", begin);
+    return s.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+}
+
+// Percent-decoding of a relative URI into a file name.
+std::string decode_uri(const std::string& uri) {
+    auto hex = [](char c) -> int {
+        if (c >= '0' && c <= '9') return c - '0';
+        if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+        if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+        return -1;
+    };
+    std::string out;
+    for (std::size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && hex(uri[i + 1]) >= 0 && hex(uri[i + 2]) >= 0) {
+            out += char(hex(uri[i + 1]) * 16 + hex(uri[i + 2]));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
+std::size_t component_size(int type) {
+    switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0; // INT and DOUBLE are not glTF 2.0 component types
+    }
+}
+
+int type_components(int type) {
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    default: return 0;
+    }
+}
+
+// One component, as stored or mapped to [0, 1] / [-1, 1] when normalized
+// (glTF 2.0, "Animation" / "Meshes": c / 127 clamped at -1, c / 255, ...).
+double component(const unsigned char* p, int type, bool normalized) {
+    switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        std::int8_t v;
+        std::memcpy(&v, p, 1);
+        return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        std::int16_t v;
+        std::memcpy(&v, p, 2);
+        return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        std::uint16_t v;
+        std::memcpy(&v, p, 2);
+        return normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        std::uint32_t v;
+        std::memcpy(&v, p, 4);
+        return normalized ? v / 4294967295.0 : v;
+    }
+    default: {
+        float v;
+        std::memcpy(&v, p, 4);
+        return v;
+    }
+    }
+}
+
+bool finite_values(const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+}
+
+Wrap wrap_mode(int mode, bool& known) {
+    known = true;
+    switch (mode) {
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return Wrap::ClampToEdge;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return Wrap::MirroredRepeat;
+    case TINYGLTF_TEXTURE_WRAP_REPEAT: return Wrap::Repeat;
+    default: known = false; return Wrap::Repeat;
+    }
+}
+
+class GltfLoader {
+public:
+    explicit GltfLoader(const std::string& path) : path_(path) {}
+
+    Scene load() {
+        parse();
+        check_required_extensions();
+        image_map_.assign(model_.images.size(), kNotYet);
+        for (std::size_t i = 0; i < model_.materials.size(); ++i)
+            scene_.materials.push_back(convert_material(model_.materials[i], i));
+        traverse_scene();
+        detail::finish_scene(scene_, path_);
+        return std::move(scene_);
+    }
+
+private:
+    static constexpr int kNotYet = -2;
+
+    [[noreturn]] void fail(const std::string& why) const { throw LoadError(path_ + ": " + why); }
+    void warn(const std::string& what) { scene_.warnings.push_back(path_ + ": " + what); }
+    void warn_once(const std::string& what) {
+        if (warned_.insert(what).second) warn(what);
+    }
+
+    // ---- Parsing (tinygltf)
+
+    void parse() {
+        std::vector<unsigned char> bytes = detail::read_file(path_);
+        const bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+        if (!glb && detail::extension_lower(path_) == ".glb")
+            fail("not a binary glTF (bad magic)");
+
+        tinygltf::TinyGLTF ctx;
+        ctx.SetImageLoader(&keep_encoded_image, nullptr);
+        tinygltf::FsCallbacks callbacks;
+        callbacks.FileExists = &tinygltf::FileExists;
+        callbacks.ExpandFilePath = &tinygltf::ExpandFilePath;
+        callbacks.ReadWholeFile = &read_whole_file;
+        callbacks.WriteWholeFile = &refuse_write;
+        callbacks.user_data = nullptr;
+        ctx.SetFsCallbacks(callbacks);
+
+        base_dir_ = fs::path(path_).parent_path().string();
+        std::string err, warnings;
+        bool ok = false;
+        if (glb) {
+            const std::size_t length = check_glb(bytes, path_);
+            check_json_depth(reinterpret_cast<const char*>(&bytes[20]), le32(&bytes[12]), path_);
+            ok = ctx.LoadBinaryFromMemory(&model_, &err, &warnings, bytes.data(),
+                                          static_cast<unsigned int>(length), base_dir_);
+        } else {
+            check_json_depth(reinterpret_cast<const char*>(bytes.data()), bytes.size(), path_);
+            ok = ctx.LoadASCIIFromString(&model_, &err, &warnings,
+                                         reinterpret_cast<const char*>(bytes.data()),
+                                         static_cast<unsigned int>(bytes.size()), base_dir_);
+        }
+        if (!ok) fail(first_line(err, "cannot parse glTF"));
+
+        // tinygltf's warnings, except the missing images that image_for() reports.
+        std::size_t start = 0;
+        while (start < warnings.size()) {
+            std::size_t end = warnings.find('\n', start);
+            if (end == std::string::npos) end = warnings.size();
+            const std::string line = warnings.substr(start, end - start);
+            start = end + 1;
+            if (line.empty() || line.rfind("File not found", 0) == 0 ||
+                line.rfind("Failed to load external 'uri' for image", 0) == 0)
+                continue;
+            warn_once(line);
+        }
+    }
+
+    void check_required_extensions() {
+        for (const std::string& ext : model_.extensionsRequired) {
+            if (ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization" ||
+                ext == "KHR_materials_emissive_strength" || ext == "KHR_materials_ior")
+                continue;
+            if (ext.rfind("KHR_materials_", 0) == 0 || ext == "KHR_texture_transform") {
+                warn("required extension " + ext + " is not supported, ignored");
+                continue;
+            }
+            fail("required extension " + ext + " is not supported");
+        }
+    }
+
+    // ---- Accessors: every offset, stride and count checked before reading
+
+    // The first byte of `count` elements of `elem` bytes starting at `offset`
+    // in bufferView `view`, and the stride between them.
+    const unsigned char* view_window(int view, std::size_t offset, std::size_t count,
+                                     std::size_t elem, bool strided, std::size_t& stride,
+                                     const std::string& what) const {
+        if (view < 0 || std::size_t(view) >= model_.bufferViews.size())
+            fail(what + ": bufferView " + std::to_string(view) + " out of range (" +
+                 std::to_string(model_.bufferViews.size()) + " bufferViews)");
+        const tinygltf::BufferView& bv = model_.bufferViews[std::size_t(view)];
+        if (bv.buffer < 0 || std::size_t(bv.buffer) >= model_.buffers.size())
+            fail(what + ": bufferView " + std::to_string(view) + ": buffer " +
+                 std::to_string(bv.buffer) + " out of range");
+        const std::vector<unsigned char>& data = model_.buffers[std::size_t(bv.buffer)].data;
+        if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
+            fail(what + ": bufferView " + std::to_string(view) + " exceeds its buffer");
+        stride = strided && bv.byteStride != 0 ? bv.byteStride : elem;
+        if (stride < elem) fail(what + ": byteStride smaller than an element");
+        if (count == 0) return nullptr;
+        // offset + (count - 1) * stride + elem <= byteLength, without overflow
+        if (offset > bv.byteLength || elem > bv.byteLength - offset ||
+            count - 1 > (bv.byteLength - offset - elem) / stride)
+            fail(what + ": accessor exceeds bufferView " + std::to_string(view));
+        return data.data() + bv.byteOffset + offset;
+    }
+
+    // Accessor `index` as count * components values of T; `type` is the
+    // required glTF type (TINYGLTF_TYPE_VEC3, ...). Sparse accessors included.
+    template <class T>
+    std::vector<T> read_accessor(int index, int type, const std::string& context) const {
+        const std::string what = context + ": accessor " + std::to_string(index);
+        if (index < 0 || std::size_t(index) >= model_.accessors.size())
+            fail(context + ": accessor " + std::to_string(index) + " out of range (" +
+                 std::to_string(model_.accessors.size()) + " accessors)");
+        const tinygltf::Accessor& a = model_.accessors[std::size_t(index)];
+        const int ncomp = type_components(a.type);
+        const std::size_t csize = component_size(a.componentType);
+        if (a.type != type || ncomp == 0) fail(what + ": wrong type");
+        if (csize == 0) fail(what + ": unsupported componentType " + std::to_string(a.componentType));
+        if (a.count > kMaxAccessorCount) fail(what + ": absurd count " + std::to_string(a.count));
+        const std::size_t elem = csize * std::size_t(ncomp);
+
+        std::vector<T> out;
+        if (a.bufferView >= 0) {
+            std::size_t stride = 0;
+            const unsigned char* p =
+                view_window(a.bufferView, a.byteOffset, a.count, elem, true, stride, what);
+            out.resize(a.count * std::size_t(ncomp));
+            for (std::size_t i = 0; i < a.count; ++i)
+                for (int c = 0; c < ncomp; ++c)
+                    out[i * std::size_t(ncomp) + std::size_t(c)] =
+                        T(component(p + i * stride + std::size_t(c) * csize, a.componentType,
+                                    a.normalized));
+        } else {
+            // No bufferView: zeros (glTF 2.0), which only sparse values may replace.
+            if (a.count > detail::kMaxSceneElements) fail(what + ": absurd count without data");
+            out.assign(a.count * std::size_t(ncomp), T(0));
+        }
+
+        if (a.sparse.isSparse) {
+            const auto& s = a.sparse;
+            if (s.count < 0 || std::size_t(s.count) > a.count) fail(what + ": bad sparse count");
+            const std::size_t isize = component_size(s.indices.componentType);
+            if (s.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
+                s.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
+                s.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || isize == 0)
+                fail(what + ": bad sparse index type");
+            if (s.indices.byteOffset < 0 || s.values.byteOffset < 0) fail(what + ": bad sparse offset");
+            std::size_t istride = 0, vstride = 0;
+            const std::size_t n = std::size_t(s.count);
+            const unsigned char* ip = view_window(s.indices.bufferView, std::size_t(s.indices.byteOffset),
+                                                  n, isize, false, istride, what + " sparse indices");
+            const unsigned char* vp = view_window(s.values.bufferView, std::size_t(s.values.byteOffset),
+                                                  n, elem, false, vstride, what + " sparse values");
+            for (std::size_t j = 0; j < n; ++j) {
+                const double target = component(ip + j * istride, s.indices.componentType, false);
+                if (target >= double(a.count)) fail(what + ": sparse index out of range");
+                for (int c = 0; c < ncomp; ++c)
+                    out[std::size_t(target) * std::size_t(ncomp) + std::size_t(c)] =
+                        T(component(vp + j * vstride + std::size_t(c) * csize, a.componentType,
+                                    a.normalized));
+            }
+        }
+        return out;
+    }
+
+    // ---- Images, textures, materials
+
+    // Scene image for glTF image i, or -1 (warned) when it cannot be used.
+    int image_for(int i) {
+        if (i < 0 || std::size_t(i) >= model_.images.size()) return -1;
+        int& mapped = image_map_[std::size_t(i)];
+        if (mapped != kNotYet) return mapped;
+        mapped = -1;
+        const tinygltf::Image& img = model_.images[std::size_t(i)];
+        ImageSource src;
+        src.name = fs::path(path_).filename().string() + "#image" + std::to_string(i);
+        if (img.bufferView >= 0) {
+            // Bounds-checked here: tinygltf does not (see the file comment).
+            const auto& views = model_.bufferViews;
+            bool ok = std::size_t(img.bufferView) < views.size();
+            if (ok) {
+                const tinygltf::BufferView& bv = views[std::size_t(img.bufferView)];
+                ok = bv.buffer >= 0 && std::size_t(bv.buffer) < model_.buffers.size();
+                if (ok) {
+                    const auto& data = model_.buffers[std::size_t(bv.buffer)].data;
+                    ok = bv.byteOffset <= data.size() && bv.byteLength <= data.size() - bv.byteOffset &&
+                         bv.byteLength > 0;
+                    if (ok)
+                        src.bytes.assign(data.begin() + std::ptrdiff_t(bv.byteOffset),
+                                         data.begin() + std::ptrdiff_t(bv.byteOffset + bv.byteLength));
+                }
+            }
+            if (!ok) {
+                warn("image " + std::to_string(i) + ": bad bufferView, texture ignored");
+                return -1;
+            }
+        } else if (!img.uri.empty()) {
+            const fs::path file = fs::path(base_dir_) / decode_uri(img.uri);
+            std::error_code ec;
+            if (!fs::is_regular_file(file, ec)) {
+                warn("image " + std::to_string(i) + " '" + img.uri + "' not found, texture ignored");
+                return -1;
+            }
+            src.path = file.lexically_normal().string();
+            src.name = src.path;
+        } else if (!img.image.empty()) {
+            src.bytes = img.image; // data URI
+        } else {
+            warn("image " + std::to_string(i) + " has no data, texture ignored");
+            return -1;
+        }
+        scene_.images.push_back(std::move(src));
+        mapped = int(scene_.images.size()) - 1;
+        return mapped;
+    }
+
+    TextureRef texture(int index, int texcoord, const tinygltf::ExtensionMap& extensions,
+                       const std::string& what) {
+        TextureRef ref;
+        if (index < 0) return ref;
+        if (std::size_t(index) >= model_.textures.size()) {
+            warn(what + ": texture " + std::to_string(index) + " out of range, ignored");
+            return ref;
+        }
+        if (texcoord != 0) {
+            warn(what + " uses TEXCOORD_" + std::to_string(texcoord) +
+                 " (only TEXCOORD_0 is supported), ignored");
+            return ref;
+        }
+        if (extensions.count("KHR_texture_transform"))
+            warn(what + ": KHR_texture_transform ignored");
+        const tinygltf::Texture& tex = model_.textures[std::size_t(index)];
+        if (tex.source < 0 || std::size_t(tex.source) >= model_.images.size()) {
+            warn(what + ": texture " + std::to_string(index) + " has no usable image source, ignored");
+            return ref;
+        }
+        ref.image = image_for(tex.source);
+        if (tex.sampler >= 0) {
+            if (std::size_t(tex.sampler) >= model_.samplers.size()) {
+                warn(what + ": sampler " + std::to_string(tex.sampler) + " out of range, REPEAT used");
+            } else {
+                const tinygltf::Sampler& s = model_.samplers[std::size_t(tex.sampler)];
+                bool known_s = true, known_t = true;
+                ref.wrap_s = wrap_mode(s.wrapS, known_s);
+                ref.wrap_t = wrap_mode(s.wrapT, known_t);
+                if (!known_s || !known_t) warn(what + ": unknown wrap mode, REPEAT used");
+            }
+        }
+        return ref;
+    }
+
+    Material convert_material(const tinygltf::Material& g, std::size_t index) {
+        Material m;
+        m.name = g.name.empty() ? "material" + std::to_string(index) : g.name;
+        const std::string what = "material '" + m.name + "'";
+        const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+
+        m.base_color_factor = glm::vec4(1.0f);
+        if (pbr.baseColorFactor.size() == 4 && finite_values(pbr.baseColorFactor))
+            m.base_color_factor = glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1],
+                                            pbr.baseColorFactor[2], pbr.baseColorFactor[3]);
+        else warn(what + ": bad baseColorFactor, white used");
+        auto unit = [](double v, float fallback) {
+            return std::isfinite(v) ? std::clamp(float(v), 0.0f, 1.0f) : fallback;
+        };
+        m.metallic_factor = unit(pbr.metallicFactor, 1.0f);
+        m.roughness_factor = unit(pbr.roughnessFactor, 1.0f);
+        m.base_color = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                               pbr.baseColorTexture.extensions, what + " baseColorTexture");
+        m.metallic_roughness =
+            texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                    pbr.metallicRoughnessTexture.extensions, what + " metallicRoughnessTexture");
+        m.normal = texture(g.normalTexture.index, g.normalTexture.texCoord,
+                           g.normalTexture.extensions, what + " normalTexture");
+        m.normal_scale = std::isfinite(g.normalTexture.scale) ? float(g.normalTexture.scale) : 1.0f;
+        m.occlusion = texture(g.occlusionTexture.index, g.occlusionTexture.texCoord,
+                              g.occlusionTexture.extensions, what + " occlusionTexture");
+        m.occlusion_strength = unit(g.occlusionTexture.strength, 1.0f);
+        m.emissive = texture(g.emissiveTexture.index, g.emissiveTexture.texCoord,
+                             g.emissiveTexture.extensions, what + " emissiveTexture");
+        m.emissive_factor = glm::vec3(0.0f);
+        if (g.emissiveFactor.size() == 3 && finite_values(g.emissiveFactor))
+            m.emissive_factor = glm::vec3(g.emissiveFactor[0], g.emissiveFactor[1], g.emissiveFactor[2]);
+        else if (!g.emissiveFactor.empty()) warn(what + ": bad emissiveFactor, black used");
+
+        if (g.alphaMode == "MASK") {
+            m.alpha_mode = AlphaMode::Mask;
+        } else if (g.alphaMode == "BLEND") {
+            warn(what + ": alphaMode BLEND is not supported, drawn opaque");
+        } else if (g.alphaMode != "OPAQUE") {
+            warn(what + ": unknown alphaMode '" + g.alphaMode + "', drawn opaque");
+        }
+        m.alpha_cutoff = std::isfinite(g.alphaCutoff) ? float(g.alphaCutoff) : 0.5f;
+        m.double_sided = g.doubleSided;
+
+        for (const auto& [name, value] : g.extensions) {
+            if (name == "KHR_materials_emissive_strength") {
+                if (value.IsObject() && value.Get("emissiveStrength").IsNumber()) {
+                    const double s = value.Get("emissiveStrength").GetNumberAsDouble();
+                    if (std::isfinite(s) && s >= 0.0) m.emissive_factor *= float(s);
+                }
+            } else if (name == "KHR_materials_ior") {
+                if (value.IsObject() && value.Get("ior").IsNumber()) {
+                    const double ior = value.Get("ior").GetNumberAsDouble();
+                    if (std::isfinite(ior) && ior >= 1.0) m.ior = float(ior);
+                }
+            } else {
+                warn(what + ": extension " + name + " ignored");
+            }
+        }
+        return m;
+    }
+
+    // ---- Nodes
+
+    glm::dmat4 local_transform(const tinygltf::Node& n, std::size_t index) {
+        const std::string what = "node " + std::to_string(index);
+        if (!n.matrix.empty()) {
+            if (n.matrix.size() == 16) {
+                glm::dmat4 m(1.0);
+                for (int c = 0; c < 4; ++c)
+                    for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[std::size_t(c * 4 + r)];
+                return m;
+            }
+            warn(what + ": matrix with " + std::to_string(n.matrix.size()) + " values ignored");
+        }
+        glm::dvec3 t(0.0), s(1.0);
+        glm::dquat r(1.0, 0.0, 0.0, 0.0);
+        if (n.translation.size() == 3) t = glm::dvec3(n.translation[0], n.translation[1], n.translation[2]);
+        else if (!n.translation.empty()) warn(what + ": bad translation ignored");
+        if (n.scale.size() == 3) s = glm::dvec3(n.scale[0], n.scale[1], n.scale[2]);
+        else if (!n.scale.empty()) warn(what + ": bad scale ignored");
+        if (n.rotation.size() == 4) {
+            // glTF stores (x, y, z, w); glm::dquat's constructor takes w first.
+            const glm::dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);
+            const double len = glm::length(q);
+            if (len > 0.0 && std::isfinite(len)) r = q / len;
+            else warn(what + ": bad rotation ignored");
+        } else if (!n.rotation.empty()) {
+            warn(what + ": bad rotation ignored");
+        }
+        return glm::translate(glm::dmat4(1.0), t) * glm::mat4_cast(r) * glm::scale(glm::dmat4(1.0), s);
+    }
+
+    // Nodes must form trees (glTF 2.0, "Nodes and Hierarchy"): one parent at
+    // most and no cycles. Checked for the whole graph so traversal cannot loop.
+    void check_node_graph() {
+        const std::size_t n = model_.nodes.size();
+        std::vector<int> parents(n, 0);
+        for (std::size_t i = 0; i < n; ++i) {
+            for (int c : model_.nodes[i].children) {
+                if (c < 0 || std::size_t(c) >= n)
+                    fail("node " + std::to_string(i) + ": child " + std::to_string(c) +
+                         " out of range (" + std::to_string(n) + " nodes)");
+                if (++parents[std::size_t(c)] > 1)
+                    fail("node " + std::to_string(c) + " has more than one parent (node graph is not a tree)");
+            }
+        }
+        // With at most one parent each, the nodes not reachable from a parentless
+        // node are exactly those on or under a cycle.
+        std::vector<char> seen(n, 0);
+        std::vector<std::size_t> stack;
+        for (std::size_t i = 0; i < n; ++i)
+            if (parents[i] == 0) stack.push_back(i);
+        while (!stack.empty()) {
+            const std::size_t i = stack.back();
+            stack.pop_back();
+            seen[i] = 1;
+            for (int c : model_.nodes[i].children) stack.push_back(std::size_t(c));
+        }
+        for (std::size_t i = 0; i < n; ++i)
+            if (!seen[i]) fail("node " + std::to_string(i) + " is part of a cycle in the node graph");
+        parentless_.clear();
+        for (std::size_t i = 0; i < n; ++i)
+            if (parents[i] == 0) parentless_.push_back(int(i));
+    }
+
+    void traverse_scene() {
+        check_node_graph();
+        std::vector<int> roots;
+        if (!model_.scenes.empty()) {
+            int s = model_.defaultScene;
+            if (s < 0 || std::size_t(s) >= model_.scenes.size()) {
+                if (s >= 0) warn("default scene " + std::to_string(s) + " out of range, scene 0 used");
+                s = 0;
+            }
+            roots = model_.scenes[std::size_t(s)].nodes;
+        } else {
+            roots = parentless_;
+        }
+
+        struct Item {
+            int node;
+            glm::dmat4 parent;
+        };
+        std::vector<Item> stack;
+        for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
+            if (*it < 0 || std::size_t(*it) >= model_.nodes.size())
+                fail("scene node " + std::to_string(*it) + " out of range (" +
+                     std::to_string(model_.nodes.size()) + " nodes)");
+            stack.push_back({*it, glm::dmat4(1.0)});
+        }
+        std::vector<char> visited(model_.nodes.size(), 0);
+        while (!stack.empty()) {
+            const Item item = stack.back();
+            stack.pop_back();
+            const std::size_t i = std::size_t(item.node);
+            if (visited[i]) {
+                warn("node " + std::to_string(i) + " is reached twice, drawn once");
+                continue;
+            }
+            visited[i] = 1;
+            const tinygltf::Node& node = model_.nodes[i];
+            const glm::dmat4 world = item.parent * local_transform(node, i);
+            if (node.mesh >= 0) {
+                if (std::size_t(node.mesh) >= model_.meshes.size())
+                    fail("node " + std::to_string(i) + ": mesh " + std::to_string(node.mesh) +
+                         " out of range (" + std::to_string(model_.meshes.size()) + " meshes)");
+                add_mesh(node, std::size_t(node.mesh), world);
+            }
+            if (node.skin >= 0) warn_once("skinning ignored (meshes drawn in bind pose)");
+            add_light(node, i, world);
+            for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
+                stack.push_back({*c, world});
+        }
+    }
+
+    // ---- Meshes
+
+    void add_mesh(const tinygltf::Node& node, std::size_t mesh_index, const glm::dmat4& world) {
+        const tinygltf::Mesh& gmesh = model_.meshes[mesh_index];
+        for (std::size_t p = 0; p < gmesh.primitives.size(); ++p) {
+            const tinygltf::Primitive& prim = gmesh.primitives[p];
+            const std::string what = "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p);
+            if (prim.mode != -1 && prim.mode != TINYGLTF_MODE_TRIANGLES) {
+                warn(what + ": mode " + std::to_string(prim.mode) +
+                     " is not supported (triangles only), skipped");
+                continue;
+            }
+            Mesh mesh;
+            mesh.name = !gmesh.name.empty() ? gmesh.name : node.name;
+            if (!read_primitive(prim, what, world, mesh)) continue;
+            if (prim.material >= 0 && std::size_t(prim.material) >= model_.materials.size()) {
+                warn(what + ": material " + std::to_string(prim.material) + " out of range, default used");
+                mesh.material = -1;
+            } else {
+                mesh.material = prim.material; // -1: finish_scene's default material
+            }
+            scene_.meshes.push_back(std::move(mesh));
+        }
+    }
+
+    // Fills mesh with the primitive's world-space vertices and triangles;
+    // false when there is nothing to draw.
+    bool read_primitive(const tinygltf::Primitive& prim, const std::string& what,
+                        const glm::dmat4& world, Mesh& mesh) {
+        const auto attribute = [&](const char* name) {
+            const auto it = prim.attributes.find(name);
+            return it == prim.attributes.end() ? -1 : it->second;
+        };
+        const int position = attribute("POSITION");
+        if (position < 0) {
+            warn(what + ": no POSITION, skipped");
+            return false;
+        }
+        for (const auto& [name, index] : prim.attributes) {
+            (void)index;
+            if (name.rfind("COLOR_", 0) == 0) warn_once("vertex colours (COLOR_n) ignored");
+            if (name.rfind("JOINTS_", 0) == 0) warn_once("skinning ignored (meshes drawn in bind pose)");
+        }
+        if (!prim.targets.empty()) warn_once("morph targets ignored");
+
+        // Read
+        const std::vector<float> pos = read_accessor<float>(position, TINYGLTF_TYPE_VEC3, what + " POSITION");
+        const std::size_t n = pos.size() / 3;
+        if (n == 0) return false;
+        budget(n);
+        std::vector<float> nrm, uv, tan;
+        const int normal = attribute("NORMAL"), texcoord = attribute("TEXCOORD_0"),
+                  tangent = attribute("TANGENT");
+        if (normal >= 0) nrm = read_accessor<float>(normal, TINYGLTF_TYPE_VEC3, what + " NORMAL");
+        if (texcoord >= 0) uv = read_accessor<float>(texcoord, TINYGLTF_TYPE_VEC2, what + " TEXCOORD_0");
+        if (tangent >= 0) tan = read_accessor<float>(tangent, TINYGLTF_TYPE_VEC4, what + " TANGENT");
+        auto same_count = [&](std::vector<float>& v, std::size_t ncomp, const char* name) {
+            if (!v.empty() && v.size() != n * ncomp) {
+                warn(what + ": " + name + " count differs from POSITION, ignored");
+                v.clear();
+            }
+        };
+        same_count(nrm, 3, "NORMAL");
+        same_count(uv, 2, "TEXCOORD_0");
+        same_count(tan, 4, "TANGENT");
+
+        std::vector<std::uint32_t> indices;
+        if (prim.indices >= 0) {
+            const std::size_t ai = std::size_t(prim.indices);
+            if (ai < model_.accessors.size()) {
+                const int ct = model_.accessors[ai].componentType;
+                if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                    ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+                    fail(what + " indices: componentType " + std::to_string(ct) +
+                         " (must be an unsigned integer)");
+            }
+            indices = read_accessor<std::uint32_t>(prim.indices, TINYGLTF_TYPE_SCALAR, what + " indices");
+            for (std::uint32_t i : indices)
+                if (i >= n)
+                    fail(what + ": index " + std::to_string(i) + " out of range (" + std::to_string(n) +
+                         " vertices)");
+        } else {
+            indices.resize(n);
+            for (std::size_t i = 0; i < n; ++i) indices[i] = std::uint32_t(i);
+        }
+        if (indices.size() % 3 != 0) {
+            warn(what + ": index count " + std::to_string(indices.size()) + " not a multiple of 3, truncated");
+            indices.resize(indices.size() / 3 * 3);
+        }
+        budget(indices.size());
+        if (indices.empty()) return false;
+
+        // Transform to world space. A mirroring transform (negative determinant)
+        // turns the winding and the tangent handedness around.
+        const glm::dmat3 linear(world);
+        const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
+        const bool mirrored = glm::determinant(linear) < 0.0;
+        mesh.positions.resize(n);
+        for (std::size_t i = 0; i < n; ++i)
+            mesh.positions[i] = glm::vec3(world * glm::dvec4(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2], 1.0));
+        if (!nrm.empty()) {
+            mesh.normals.resize(n);
+            for (std::size_t i = 0; i < n; ++i)
+                mesh.normals[i] = glm::vec3(glm::normalize(normal_matrix * glm::dvec3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2])));
+        }
+        if (!uv.empty()) {
+            mesh.uvs.resize(n);
+            for (std::size_t i = 0; i < n; ++i) mesh.uvs[i] = glm::vec2(uv[2 * i], uv[2 * i + 1]);
+        }
+        if (!tan.empty() && !uv.empty()) {
+            mesh.tangents.resize(n);
+            for (std::size_t i = 0; i < n; ++i) {
+                const glm::dvec3 t = glm::normalize(linear * glm::dvec3(tan[4 * i], tan[4 * i + 1], tan[4 * i + 2]));
+                const float w = tan[4 * i + 3] < 0.0f ? -1.0f : 1.0f;
+                mesh.tangents[i] = glm::vec4(glm::vec3(t), mirrored ? -w : w);
+            }
+        }
+        if (mirrored)
+            for (std::size_t t = 0; t < indices.size(); t += 3) std::swap(indices[t + 1], indices[t + 2]);
+        mesh.indices = std::move(indices);
+        return true;
+    }
+
+    // Keeps the flattened scene (meshes instanced by many nodes are copied)
+    // within kMaxSceneElements vertices and as many indices.
+    void budget(std::size_t elements) {
+        elements_ += elements;
+        if (elements_ > 2 * detail::kMaxSceneElements)
+            fail("scene too large (over " + std::to_string(detail::kMaxSceneElements) + " vertices/indices)");
+    }
+
+    // ---- Lights (KHR_lights_punctual)
+
+    void add_light(const tinygltf::Node& node, std::size_t index, const glm::dmat4& world) {
+        const auto ext = node.extensions.find("KHR_lights_punctual");
+        if (ext == node.extensions.end()) return;
+        const tinygltf::Value& v = ext->second;
+        const std::string what = "node " + std::to_string(index);
+        if (!v.IsObject() || !v.Get("light").IsNumber()) {
+            warn(what + ": bad KHR_lights_punctual, ignored");
+            return;
+        }
+        const int li = v.Get("light").GetNumberAsInt();
+        if (li < 0 || std::size_t(li) >= model_.lights.size()) {
+            warn(what + ": light " + std::to_string(li) + " out of range, ignored");
+            return;
+        }
+        const tinygltf::Light& gl = model_.lights[std::size_t(li)];
+        Light light;
+        if (gl.color.size() == 3 && finite_values(gl.color))
+            light.color = glm::vec3(gl.color[0], gl.color[1], gl.color[2]);
+        light.intensity = std::isfinite(gl.intensity) ? float(gl.intensity) : 1.0f;
+        if (gl.type == "directional") {
+            // The light shines along its node's -Z; we store the way back to it.
+            const glm::dvec3 towards = glm::dmat3(world) * glm::dvec3(0.0, 0.0, 1.0);
+            const double len = glm::length(towards);
+            if (!(len > 0.0) || !std::isfinite(len)) {
+                warn(what + ": directional light with a degenerate transform, ignored");
+                return;
+            }
+            light.type = Light::Type::Directional;
+            light.direction = glm::vec3(towards / len);
+        } else if (gl.type == "point" || gl.type == "spot") {
+            if (gl.type == "spot") warn_once("spot lights are drawn as point lights");
+            light.type = Light::Type::Point;
+            light.position = glm::vec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+            if (!std::isfinite(light.position.x) || !std::isfinite(light.position.y) ||
+                !std::isfinite(light.position.z)) {
+                warn(what + ": point light with a non-finite position, ignored");
+                return;
+            }
+        } else {
+            warn(what + ": light type '" + gl.type + "' unknown, ignored");
+            return;
+        }
+        scene_.lights.push_back(light);
+    }
+
+    const std::string& path_;
+    std::string base_dir_;
+    tinygltf::Model model_;
+    Scene scene_;
+    std::vector<int> image_map_; // glTF image -> Scene image, kNotYet or -1
+    std::vector<int> parentless_;
+    std::set<std::string> warned_;
+    std::size_t elements_ = 0;
+};
+
+} // namespace
+
+Scene load_gltf(const std::string& path) {
+    try {
+        return GltfLoader(path).load();
+    } catch (const LoadError&) {
+        throw;
+    } catch (const std::exception& e) {
+        // tinygltf and nlohmann::json may throw (out_of_range, bad_alloc, ...).
+        throw LoadError(path + ": " + e.what());
+    }
+}
+
+} // namespace prast

@@ -1,0 +1,54 @@
+// Scene loading: Wavefront OBJ + MTL (tinyobjloader) and glTF 2.0 (.gltf with
+// external or data-URI buffers, and .glb; tinygltf) into the world-space Scene
+// of scene.h. Images are not decoded here: the loaders fill ImageSource with a
+// path or the encoded bytes, and texture.h decodes them.
+//
+// Errors: a file that cannot be used throws LoadError with one line
+// "FILE: problem". A problem the loader can work around (a missing texture, an
+// unsupported extension or primitive mode, triangles with NaN corners) is one
+// line "FILE: ..." in Scene::warnings, and the scene still loads. No input may
+// crash or hang a loader: every index, offset and size in the file is checked.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "shading/scene.h"
+
+namespace prast {
+
+// Dispatches on the extension, case-insensitively: .obj, .gltf or .glb.
+Scene load_scene(const std::string& path);
+
+// OBJ + MTL. One Mesh per (object/group, material); UVs become v = 1 - v_obj.
+Scene load_obj(const std::string& path);
+
+// glTF 2.0, text (.gltf) or binary (.glb): the default scene's node hierarchy
+// is flattened into world-space meshes; KHR_lights_punctual gives the lights.
+Scene load_gltf(const std::string& path);
+
+namespace detail {
+
+// Limits that keep a hostile file from exhausting memory; each is far beyond
+// the assets the project renders (the largest has 70 k triangles).
+constexpr std::size_t kMaxFileBytes = std::size_t(1) << 31;      // 2 GiB
+constexpr std::size_t kMaxSceneElements = std::size_t(1) << 28;  // vertices or indices
+
+// The whole file, or LoadError "PATH: cannot open file" / "is a directory" /
+// "empty file" / "file too large".
+std::vector<unsigned char> read_file(const std::string& path);
+
+// Lower-case extension with the dot ("" when none).
+std::string extension_lower(const std::string& path);
+
+// Shared last step of both loaders: per mesh, drops triangles with an index out
+// of range or a non-finite corner (one warning with the count), removes unused
+// vertices, repairs or computes normals and tangents, drops meshes without
+// triangles, makes sure materials is not empty and every mesh's material is
+// valid. Throws LoadError "PATH: no triangles" when nothing is left.
+void finish_scene(Scene& scene, const std::string& path);
+
+} // namespace detail
+
+} // namespace prast
