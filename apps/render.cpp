@@ -339,6 +339,9 @@ int run(int argc, char** argv) {
         try {
             if (opt.hdr_output()) {
                 write_hdr_atomic(path, fb.width, fb.height, fb.color.data());
+            } else if (debug_view_is_data(opt.view)) {
+                resolve_raw8(fb.color.data(), fb.width, fb.height, rgba8.data());
+                write_png_atomic(path, fb.width, fb.height, rgba8.data());
             } else {
                 resolve_to_srgb8(fb.color.data(), fb.width, fb.height, opt.exposure, opt.effective_tonemap(),
                                  rgba8.data());

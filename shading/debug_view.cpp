@@ -22,6 +22,16 @@ bool parse_debug_view(const std::string& name, DebugView& out) {
     return false;
 }
 
+bool debug_view_is_data(DebugView v) {
+    switch (v) {
+    case DebugView::Normal: case DebugView::Roughness: case DebugView::Metallic: case DebugView::Uv:
+    case DebugView::Depth: case DebugView::Ndf: case DebugView::Fresnel: case DebugView::Geometry:
+        return true;
+    default:
+        return false;
+    }
+}
+
 const char* debug_view_names() {
     return "albedo, normal, roughness, metallic, uv, depth, overdraw, tiles, ndf, fresnel, "
            "geometry, diffuse, specular";

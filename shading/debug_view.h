@@ -12,6 +12,11 @@ enum class DebugView {
 };
 
 bool parse_debug_view(const std::string& name, DebugView& out);
+
+// Views of data rather than colour (normals, roughness, metallic, uv, depth,
+// D, F, G): written to 8 bits as they are, without tone map or sRGB encoding,
+// so that a byte reads back as the value (byte / 255).
+bool debug_view_is_data(DebugView v);
 const char* debug_view_names();  // "albedo, normal, ..." for messages
 
 } // namespace prast

@@ -115,4 +115,16 @@ void resolve_to_srgb8(const float* rgba_linear, int width, int height, float exp
     }
 }
 
+void resolve_raw8(const float* rgba, int width, int height, std::uint8_t* out) {
+    std::size_t count = std::size_t(width) * std::size_t(height);
+    for (std::size_t i = 0; i < count; ++i) {
+        for (int c = 0; c < 3; ++c) {
+            float x = rgba[i * 4 + c];
+            x = x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f;  // NaN -> 0
+            out[i * 4 + c] = std::uint8_t(std::floor(x * 255.0f + 0.5f));
+        }
+        out[i * 4 + 3] = 255;
+    }
+}
+
 } // namespace prast

@@ -28,4 +28,7 @@ glm::vec3 tonemap(glm::vec3 linear, ToneMap tm);
 void resolve_to_srgb8(const float* rgba_linear, int width, int height, float exposure,
                       ToneMap tm, std::uint8_t* rgba8_out);
 
+// Data (debug views) to 8 bits as is: clamp to [0, 1], * 255, round; alpha 255.
+void resolve_raw8(const float* rgba, int width, int height, std::uint8_t* rgba8_out);
+
 } // namespace prast

@@ -1189,32 +1189,44 @@ TEST_CASE("clipping: degenerate and invalid triangles are dropped and counted") 
     CHECK_THROWS_AS(r.draw(empty, p, n, tail.data(), 3, st), std::invalid_argument);
 }
 
-TEST_CASE("clipping: extreme finite and w = 0 positions do not crash or write NaN") {
+TEST_CASE("clipping: a vertex at clip (0, 0, 0, 0) drops its triangle, it does not draw garbage") {
+    // gl_Position = vec4(0) is the usual way to kill a vertex; the point satisfies
+    // -w <= x, y, z <= w, so only an explicit w > 0 requirement keeps it out of
+    // the perspective divide (0 / 0).
     const int W = 64, H = 48;
-    Renderer r(RendererOptions{2, 16});
-    const float big = 3.0e38f;
-    std::vector<glm::vec4> clip = {
-        glm::vec4(-big, -1, 0, 1), glm::vec4(big, -1, 0, 1), glm::vec4(0, big, 0, 1),     // 0-2
-        glm::vec4(0, 0, 0, 0), glm::vec4(0.5f, 0, 0, 1), glm::vec4(0, 0.5f, 0, 1),       // 3-5: w = 0 at the origin
-        glm::vec4(0, 0, 0, 1e-30f), glm::vec4(-big, big, 0, 1),                          // 6-7
+    Renderer r(RendererOptions{1, 16});
+    const std::vector<std::vector<glm::vec4>> cases = {
+        {glm::vec4(0, 0, 0, 0), glm::vec4(0.5f, 0, 0, 1), glm::vec4(0, 0.5f, 0, 1)},
+        {glm::vec4(0, 0, 0, -0.0f), glm::vec4(0.5f, 0, 0, 1), glm::vec4(0, 0.5f, 0, 1)},
+        {glm::vec4(0.5f, 0, 0, 1), glm::vec4(0, 0.5f, 0, 1), glm::vec4(0, 0, 0, 0)},
+        {glm::vec4(0), glm::vec4(0), glm::vec4(0)},
     };
-    std::vector<std::uint32_t> idx = {0, 1, 2, 3, 4, 5, 6, 4, 5, 0, 7, 1};
-    Framebuffer fb(W, H);
-    ClipProgram<0> p;
-    p.clip = clip.data();
-    DrawState st;
-    st.cull = CullMode::None;
-    r.begin_frame();
-    r.draw(fb, p, std::uint32_t(clip.size()), idx.data(), idx.size(), st);
-    const FrameStats& s = r.stats();
-    CHECK(s.triangles_in == 4);
-    int bad = 0;
-    for (float v : fb.color) bad += !std::isfinite(v);
-    for (float z : fb.depth) bad += !(z >= 0.0f && z <= 1.0f);
-    CHECK(bad == 0);
-    MESSAGE("extreme positions: setup " << s.triangles_setup << ", clipped " << s.triangles_clipped << ", degenerate "
-                                        << s.triangles_degenerate << ", culled " << s.triangles_culled_frustum
-                                        << ", fragments " << s.fragments_covered);
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+        CAPTURE(i);
+        FrameStats s;
+        std::vector<int> c = draw_counts(r, W, H, cases[i], {0, 1, 2}, CullMode::None, &s);
+        CHECK(s.triangles_setup == 0);
+        CHECK(s.fragments_covered == 0);
+        CHECK(count_not_equal(c, 0) == 0);
+        CHECK(s.triangles_invalid + s.triangles_culled_frustum + s.triangles_degenerate >= 1);
+    }
+}
+
+TEST_CASE("clipping: huge finite clip coordinates (1e8 to 3e38) still cover the viewport exactly once") {
+    // The guard-band clipper must place its new vertices on the guard band however
+    // far away the input vertices are; in single precision the cut point of an
+    // edge from -1e12 to +1e12 rounds to the middle of the edge (x = 0) instead.
+    const int W = 200, H = 150;
+    Renderer r(RendererOptions{1, 64});
+    for (float big : {1e8f, 1e12f, 1e20f, 3e38f}) {
+        CAPTURE(big);
+        std::vector<glm::vec4> clip = {glm::vec4(-big, -1, 0, 1), glm::vec4(big, -1, 0, 1), glm::vec4(0, big, 0, 1)};
+        FrameStats s;
+        std::vector<int> c = draw_counts(r, W, H, clip, {0, 1, 2}, CullMode::None, &s);
+        CHECK(count_not_equal(c, 1) == 0);
+        CHECK(s.triangles_clipped == 1);
+        CHECK(s.triangles_culled_frustum == 0);
+    }
 }
 
 // ===========================================================================
@@ -1827,6 +1839,25 @@ TEST_CASE("stats: counters of a closed sphere, single- and double-sided") {
     CHECK(r.stats().draws == 1);
     CHECK(r.stats().triangles_in == 0);
     CHECK(!r.stats().to_string().empty());
+}
+
+TEST_CASE("stats: a back face split by clipping counts once in triangles_culled_back") {
+    // Clockwise in NDC and far beyond the guard band: the clipper cuts it into a
+    // fan of pieces, but one submitted triangle was culled.
+    const int W = 64, H = 48;
+    Renderer r(RendererOptions{1, 16});
+    std::vector<glm::vec4> clip = {glm::vec4(-2e4f, -2e4f, 0, 1), glm::vec4(-2e4f, 6e4f, 0, 1), glm::vec4(6e4f, -2e4f, 0, 1)};
+    FrameStats s;
+    std::vector<int> c = draw_counts(r, W, H, clip, {0, 1, 2}, CullMode::Back, &s);
+    CHECK(count_not_equal(c, 0) == 0);
+    CHECK(s.triangles_in == 1);
+    CHECK(s.triangles_clipped == 1);
+    CHECK(s.triangles_setup == 0);
+    CHECK(s.triangles_culled_back == 1);
+    // Drawn double-sided it covers everything once, from several pieces.
+    c = draw_counts(r, W, H, clip, {0, 1, 2}, CullMode::None, &s);
+    CHECK(count_not_equal(c, 1) == 0);
+    CHECK(s.triangles_setup >= 2);
 }
 
 } // TEST_SUITE

@@ -169,3 +169,19 @@ TEST_CASE("resolve_to_srgb8 equals the per-pixel reference") {
 }
 
 } // TEST_SUITE
+
+TEST_SUITE("tonemap") {
+TEST_CASE("resolve_raw8 writes data views as value * 255, no sRGB") {
+    const float px[8] = {0.0f, 0.5f, 1.0f, 0.2f, -1.0f, 2.0f, std::nanf(""), 0.0f};
+    std::uint8_t out[8];
+    prast::resolve_raw8(px, 2, 1, out);
+    CHECK(out[0] == 0);
+    CHECK(out[1] == 128);  // floor(127.5 + 0.5)
+    CHECK(out[2] == 255);
+    CHECK(out[3] == 255);  // alpha
+    CHECK(out[4] == 0);    // clamped
+    CHECK(out[5] == 255);
+    CHECK(out[6] == 0);    // NaN
+    CHECK(out[7] == 255);
+}
+}
