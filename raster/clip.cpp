@@ -20,7 +20,10 @@ std::uint32_t outcode(const float* c, const GuardBand& gb) {
     if (x > w) code |= kOutRight;
     if (y < -w) code |= kOutBottom;
     if (y > w) code |= kOutTop;
-    if (z < -w) code |= kOutNear;
+    // w <= 0 (a vertex at or behind the eye plane) always goes through the
+    // clipper: a degenerate w = 0 vertex can sit on the near plane (0 >= -0),
+    // and only the clipped path checks w > 0 before the perspective divide.
+    if (z < -w || !(w > 0.0f)) code |= kOutNear;
     if (z > w) code |= kOutFar;
     if (x < -gb.x * w) code |= kOutGuardLeft;
     if (x > gb.x * w) code |= kOutGuardRight;
@@ -31,20 +34,38 @@ std::uint32_t outcode(const float* c, const GuardBand& gb) {
 
 namespace {
 
-// Signed distance to a plane, >= 0 inside.
-float plane_distance(std::uint32_t plane, const float* c, const GuardBand& gb) {
+// Signed distance to a plane, >= 0 inside. Double precision: with vertices
+// at 1e20 the float difference of two distances would lose the cut point.
+double plane_distance(std::uint32_t plane, const float* c, const GuardBand& gb) {
+    double x = c[0], y = c[1], z = c[2], w = c[3];
     switch (plane) {
-    case kOutNear: return c[2] + c[3];
-    case kOutFar: return c[3] - c[2];
-    case kOutGuardLeft: return c[0] + gb.x * c[3];
-    case kOutGuardRight: return gb.x * c[3] - c[0];
-    case kOutGuardBottom: return c[1] + gb.y * c[3];
-    default: return gb.y * c[3] - c[1];  // kOutGuardTop
+    case kOutNear: return z + w;
+    case kOutFar: return w - z;
+    case kOutGuardLeft: return x + double(gb.x) * w;
+    case kOutGuardRight: return double(gb.x) * w - x;
+    case kOutGuardBottom: return y + double(gb.y) * w;
+    default: return double(gb.y) * w - y;  // kOutGuardTop
     }
 }
 
-void lerp_vertex(const float* in, const float* out_side, float t, int stride, float* dst) {
-    for (int k = 0; k < stride; ++k) dst[k] = in[k] + t * (out_side[k] - in[k]);
+void lerp_vertex(const float* in, const float* out_side, double t, int stride, float* dst) {
+    for (int k = 0; k < stride; ++k)
+        dst[k] = float(double(in[k]) + t * (double(out_side[k]) - double(in[k])));
+}
+
+// Puts a new vertex exactly on the plane it was cut at. When both ends of an
+// edge are far away (1e20 and beyond) the relative error of t, times the edge
+// length, exceeds the guard band itself; snapping the plane's own coordinate
+// keeps the vertex on the plane (and the others only move along the plane).
+void snap_to_plane(std::uint32_t plane, const GuardBand& gb, float* v) {
+    switch (plane) {
+    case kOutNear: v[2] = -v[3]; break;
+    case kOutFar: v[2] = v[3]; break;
+    case kOutGuardLeft: v[0] = -gb.x * v[3]; break;
+    case kOutGuardRight: v[0] = gb.x * v[3]; break;
+    case kOutGuardBottom: v[1] = -gb.y * v[3]; break;
+    default: v[1] = gb.y * v[3]; break;  // kOutGuardTop
+    }
 }
 
 } // namespace
@@ -66,8 +87,8 @@ int clip_triangle(const float* const v[3], int stride, std::uint32_t planes,
         for (int i = 0; i < n; ++i) {
             const float* a = &src[i * stride];
             const float* b = &src[((i + 1) % n) * stride];
-            float da = plane_distance(plane, a, gb), db = plane_distance(plane, b, gb);
-            bool a_in = da >= 0.0f, b_in = db >= 0.0f;
+            double da = plane_distance(plane, a, gb), db = plane_distance(plane, b, gb);
+            bool a_in = da >= 0.0, b_in = db >= 0.0;
             if (a_in) {
                 std::memcpy(&dst[m * stride], a, sizeof(float) * stride);
                 ++m;
@@ -76,6 +97,7 @@ int clip_triangle(const float* const v[3], int stride, std::uint32_t planes,
                 // Cut from the inside end: t measured from the inside vertex.
                 if (a_in) lerp_vertex(a, b, da / (da - db), stride, &dst[m * stride]);
                 else lerp_vertex(b, a, db / (db - da), stride, &dst[m * stride]);
+                snap_to_plane(plane, gb, &dst[m * stride]);
                 ++m;
             }
         }

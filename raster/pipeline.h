@@ -90,18 +90,19 @@ void Renderer::setup_and_bin(BinJob& job, std::size_t tri_begin, std::size_t tri
     float polygon[kMaxClippedVertices * (4 + kMaxVaryings)];
     FrameStats& st = job.stats;
 
-    auto emit = [&](const float* const clip[3], const std::uint32_t ref[3], std::uint32_t prim, bool clipped) {
+    // Sets up one (piece of a) triangle and bins it. Counting is left to the
+    // caller, so that a clipped triangle counts once however many pieces it has.
+    auto emit = [&](const float* const clip[3], const std::uint32_t ref[3], std::uint32_t prim,
+                    bool clipped) -> SetupResult {
         TriangleSetup t;
         SetupResult r = setup_triangle(clip, ref, grid.width, grid.height, cull_back, t);
         if (r == SetupResult::CulledBack) {
-            ++st.triangles_culled_back;
             if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::CulledBack, clipped, nullptr);
-            return;
+            return r;
         }
         if (r == SetupResult::Degenerate) {
-            ++st.triangles_degenerate;
             if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::Degenerate, clipped, nullptr);
-            return;
+            return r;
         }
         t.prim_id = prim;
         std::uint32_t index = std::uint32_t(job.setups.size());
@@ -112,6 +113,11 @@ void Renderer::setup_and_bin(BinJob& job, std::size_t tri_begin, std::size_t tri
             if constexpr (Observer::enabled) obs.binned(prim, int(tile));
             (void)tile;
         });
+        return r;
+    };
+    auto count = [&](bool any_setup, bool any_back) {
+        if (any_back) ++st.triangles_culled_back;
+        else if (!any_setup) ++st.triangles_degenerate;
     };
 
     for (std::size_t tri = tri_begin; tri < tri_end; ++tri) {
@@ -140,7 +146,8 @@ void Renderer::setup_and_bin(BinJob& job, std::size_t tri_begin, std::size_t tri
         }
         std::uint32_t planes = (oc0 | oc1 | oc2) & kClipNeededBits;
         if (!planes) {
-            emit(clip, ref, prim, false);
+            SetupResult r = emit(clip, ref, prim, false);
+            count(r == SetupResult::Ok, r == SetupResult::CulledBack);
             continue;
         }
         // Clip; the polygon's vertices go to this job's pool and the pieces are a fan.
@@ -155,6 +162,7 @@ void Renderer::setup_and_bin(BinJob& job, std::size_t tri_begin, std::size_t tri
         }
         std::uint32_t base = std::uint32_t(job.clip_pool.size() / stride);
         job.clip_pool.insert(job.clip_pool.end(), polygon, polygon + n * stride);
+        bool any_setup = false, any_back = false;
         for (int i = 1; i + 1 < n; ++i) {
             std::uint32_t pref[3] = {(base | kClippedVertexBit), ((base + i) | kClippedVertexBit),
                                      ((base + i + 1) | kClippedVertexBit)};
@@ -162,8 +170,11 @@ void Renderer::setup_and_bin(BinJob& job, std::size_t tri_begin, std::size_t tri
             const float* pclip[3] = {&job.clip_pool[std::size_t(base) * stride],
                                      &job.clip_pool[std::size_t(base + i) * stride],
                                      &job.clip_pool[std::size_t(base + i + 1) * stride]};
-            emit(pclip, pref, prim, true);
+            SetupResult r = emit(pclip, pref, prim, true);
+            any_setup |= r == SetupResult::Ok;
+            any_back |= r == SetupResult::CulledBack;
         }
+        count(any_setup, any_back);
     }
 }
 

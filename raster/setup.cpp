@@ -12,10 +12,15 @@ SetupResult setup_triangle(const float* const clip[3], const std::uint32_t ref[3
     // Double precision so that vertices far out in the guard band snap exactly.
     std::int64_t fx[3], fy[3];
     float z[3], inv_w[3];
+    // Callers clip to w > 0 and the guard band; a vertex outside them anyway
+    // (a contract broken by hand) is refused rather than overflowing llrint.
+    const double limit = 2.0 * kGuardBandPixels;
     for (int i = 0; i < 3; ++i) {
         double w = clip[i][3];
         double x_win = (double(clip[i][0]) / w + 1.0) * 0.5 * width;
         double y_win = (1.0 - double(clip[i][1]) / w) * 0.5 * height;
+        if (!(w > 0.0) || !(std::fabs(x_win) <= limit) || !(std::fabs(y_win) <= limit))
+            return SetupResult::Degenerate;
         fx[i] = std::llrint(x_win * double(kSubPixelScale));
         fy[i] = std::llrint(y_win * double(kSubPixelScale));
         z[i] = float((double(clip[i][2]) / w + 1.0) * 0.5);

@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <type_traits>
 #include <utility>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -358,6 +359,8 @@ private:
         if (csize == 0) fail(what + ": unsupported componentType " + std::to_string(a.componentType));
         if (a.count > kMaxAccessorCount) fail(what + ": absurd count " + std::to_string(a.count));
         const std::size_t elem = csize * std::size_t(ncomp);
+        // `normalized` means nothing for indices.
+        const bool normalized = a.normalized && std::is_floating_point_v<T>;
 
         std::vector<T> out;
         if (a.bufferView >= 0) {
@@ -369,7 +372,7 @@ private:
                 for (int c = 0; c < ncomp; ++c)
                     out[i * std::size_t(ncomp) + std::size_t(c)] =
                         T(component(p + i * stride + std::size_t(c) * csize, a.componentType,
-                                    a.normalized));
+                                    normalized));
         } else {
             // No bufferView: zeros (glTF 2.0), which only sparse values may replace.
             if (a.count > detail::kMaxSceneElements) fail(what + ": absurd count without data");
@@ -397,7 +400,7 @@ private:
                 for (int c = 0; c < ncomp; ++c)
                     out[std::size_t(target) * std::size_t(ncomp) + std::size_t(c)] =
                         T(component(vp + j * vstride + std::size_t(c) * csize, a.componentType,
-                                    a.normalized));
+                                    normalized));
             }
         }
         return out;
