@@ -24,7 +24,11 @@
 
 namespace prast {
 
-constexpr const char* kRenderVersion = "0.1.0";
+// The project version, from CMake's project(VERSION ...).
+#ifndef PRAST_VERSION
+#define PRAST_VERSION "unknown"
+#endif
+constexpr const char* kRenderVersion = PRAST_VERSION;
 
 // Memory a frame costs per pixel: the framebuffer (RGBA float colour 16 +
 // float depth 4) and the 8-bit copy that is encoded.
