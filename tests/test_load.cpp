@@ -18,47 +18,25 @@
 
 #include <stb_image_write.h>
 
+#include "tests/scratch.h"
+
 #include "shading/load_scene.h"
 #include "shading/tangents.h"
 
 namespace fs = std::filesystem;
 using namespace prast;
+using prast::test::TempDir;
+using prast::test::read_bytes;
+using prast::test::write_bytes;
+using prast::test::write_text;
 
 namespace {
 
 // ---- Scratch files
 
-// A unique scratch directory, removed with everything in it at scope exit.
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        static int counter = 0;
-        const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
-        path = fs::temp_directory_path() /
-               ("prast_test_load_" + std::to_string(stamp) + "_" + std::to_string(++counter));
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-};
 
-void write_text(const std::string& path, const std::string& text) {
-    std::ofstream f(path, std::ios::binary);
-    f << text;
-}
 
-void write_bytes(const std::string& path, const std::vector<unsigned char>& bytes) {
-    std::ofstream f(path, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-}
 
-[[maybe_unused]] std::vector<unsigned char> read_bytes(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    return std::vector<unsigned char>(std::istreambuf_iterator<char>(f), {});
-}
 
 // A 2x2 RGB PNG, in memory.
 std::vector<unsigned char> tiny_png() {
@@ -461,7 +439,7 @@ TEST_SUITE("load") {
 // ---- OBJ
 
 TEST_CASE("OBJ quad with every map: counts, factors, maps, v flip, normals, tangents") {
-    TempDir dir;
+    TempDir dir("load");
     write_text(dir.file("quad.obj"), kQuadObj);
     write_text(dir.file("quad.mtl"), kQuadMtl);
     write_pngs(dir, {"albedo.png", "rough.png", "metal.png", "emit.png", "normal.png", "ao.png"});
@@ -512,7 +490,7 @@ TEST_CASE("OBJ quad with every map: counts, factors, maps, v flip, normals, tang
 }
 
 TEST_CASE("OBJ factors: absent keys count as 1 with a map, else the defaults") {
-    TempDir dir;
+    TempDir dir("load");
     // "kd" first: tinyobjloader keeps its has_kd flag across materials, which
     // the loader must not inherit.
     write_text(dir.file("m.mtl"), "newmtl kd\nKd 0.1 0.2 0.3\n\n"
@@ -555,7 +533,7 @@ TEST_CASE("OBJ factors: absent keys count as 1 with a map, else the defaults") {
 }
 
 TEST_CASE("OBJ with two materials in one object gives two meshes") {
-    TempDir dir;
+    TempDir dir("load");
     write_text(dir.file("two.mtl"), "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n");
     write_text(dir.file("two.obj"), "mtllib two.mtl\no thing\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                     "v 2 0 0\nv 2 1 0\n"
@@ -582,7 +560,7 @@ TEST_CASE("OBJ with two materials in one object gives two meshes") {
 }
 
 TEST_CASE("OBJ smooth normals are area-weighted and shared across UV seams") {
-    TempDir dir;
+    TempDir dir("load");
     // Two triangles folded along the X axis, with different UVs for the
     // shared edge: the edge's normals are the area-weighted mean.
     write_text(dir.file("fold.obj"), "v 0 0 0\nv 1 0 0\nv 0 2 0\nv 0 0 1\n"
@@ -599,7 +577,7 @@ TEST_CASE("OBJ smooth normals are area-weighted and shared across UV seams") {
 }
 
 TEST_CASE("OBJ: an MTL naming a missing map warns and falls back") {
-    TempDir dir;
+    TempDir dir("load");
     write_text(dir.file("quad.obj"), kQuadObj);
     write_text(dir.file("quad.mtl"), "newmtl full\nmap_Kd missing.png\nmap_Pr rough.png\n");
     write_pngs(dir, {"rough.png"});
@@ -615,7 +593,7 @@ TEST_CASE("OBJ: an MTL naming a missing map warns and falls back") {
 }
 
 TEST_CASE("OBJ: a missing MTL file warns and uses the default material") {
-    TempDir dir;
+    TempDir dir("load");
     write_text(dir.file("quad.obj"), kQuadObj);
     const Scene s = load_scene(dir.file("quad.obj"));
     check_sane(s);
@@ -625,7 +603,7 @@ TEST_CASE("OBJ: a missing MTL file warns and uses the default material") {
 }
 
 TEST_CASE("OBJ: triangles with NaN or Inf corners are dropped with a warning") {
-    TempDir dir;
+    TempDir dir("load");
     // tinyobjloader reads 0e999 as 0 * inf = NaN and 1e999 as inf.
     write_text(dir.file("nan.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0e999 0 0\nv 1e999 1 0\n"
                                     "f 1 2 3\nf 1 2 4\nf 2 3 5\nf 4 5 1\n");
@@ -642,7 +620,7 @@ TEST_CASE("OBJ: triangles with NaN or Inf corners are dropped with a warning") {
 }
 
 TEST_CASE("OBJ: out-of-range face indices and huge polygons are LoadErrors") {
-    TempDir dir;
+    TempDir dir("load");
     write_text(dir.file("range.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n");
     check_load_error(dir.file("range.obj"), "out of range");
     write_text(dir.file("range_quad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 9\n");
@@ -671,14 +649,14 @@ TEST_CASE("OBJ: out-of-range face indices and huge polygons are LoadErrors") {
 // ---- glTF
 
 TEST_CASE("glTF with a data-URI buffer: transforms, indices, material, lights") {
-    TempDir dir;
+    TempDir dir("load");
     write_text(dir.file("quad.gltf"), quad_gltf());
     const Scene s = load_scene(dir.file("quad.gltf"));
     check_quad_scene(s);
 }
 
 TEST_CASE("glb: the same quad from the BIN chunk") {
-    TempDir dir;
+    TempDir dir("load");
     write_bytes(dir.file("quad.glb"), quad_glb());
     check_quad_scene(load_scene(dir.file("quad.glb")));
     // Extensions are case-insensitive.
@@ -687,7 +665,7 @@ TEST_CASE("glb: the same quad from the BIN chunk") {
 }
 
 TEST_CASE("glTF: a mirroring node flips the winding and the tangent handedness") {
-    TempDir dir;
+    TempDir dir("load");
     std::string json = quad_gltf();
     replace_once(json, "\"scale\": [2, 2, 2]", "\"scale\": [-2, 2, 2]");
     write_text(dir.file("mirror.gltf"), json);
@@ -713,7 +691,7 @@ TEST_CASE("glTF: a mirroring node flips the winding and the tangent handedness")
 }
 
 TEST_CASE("glTF: without NORMAL, normals are computed; without TANGENT, tangents") {
-    TempDir dir;
+    TempDir dir("load");
     std::string json = quad_gltf();
     replace_once(json, "\"NORMAL\": 1, ", "");
     replace_once(json, ", \"TANGENT\": 3", "");
@@ -731,7 +709,7 @@ TEST_CASE("glTF: without NORMAL, normals are computed; without TANGENT, tangents
 }
 
 TEST_CASE("glTF: recoverable problems are warnings") {
-    TempDir dir;
+    TempDir dir("load");
     SUBCASE("missing external image") {
         std::string json = quad_gltf();
         const std::string png_uri = data_uri(tiny_png(), "image/png");
@@ -779,7 +757,7 @@ TEST_CASE("glTF: recoverable problems are warnings") {
 }
 
 TEST_CASE("glTF: corrupt files are LoadErrors naming the file") {
-    TempDir dir;
+    TempDir dir("load");
     struct Case {
         const char* name;
         const char* from;
@@ -837,7 +815,7 @@ TEST_CASE("glTF: corrupt files are LoadErrors naming the file") {
 }
 
 TEST_CASE("glb: bad headers and chunk lengths are LoadErrors") {
-    TempDir dir;
+    TempDir dir("load");
     const std::vector<unsigned char> good = quad_glb();
     auto with = [&](const char* name, std::vector<unsigned char> bytes, const char* expect = "") {
         write_bytes(dir.file(name), bytes);
@@ -867,7 +845,7 @@ TEST_CASE("glb: bad headers and chunk lengths are LoadErrors") {
 // ---- Any file
 
 TEST_CASE("missing, directory, empty and unknown files are LoadErrors") {
-    TempDir dir;
+    TempDir dir("load");
     check_load_error(dir.file("nope.obj"), "no such file");
     check_load_error(dir.file("nope.gltf"), "no such file");
     fs::create_directories(dir.file("folder.obj"));
@@ -903,7 +881,7 @@ TEST_CASE("tangents: degenerate UVs give a perpendicular unit tangent") {
 // ---- Fuzzing
 
 TEST_CASE("fuzzed OBJ, MTL, glTF and glb files load or throw LoadError") {
-    TempDir dir;
+    TempDir dir("load");
     write_pngs(dir, {"albedo.png", "rough.png", "metal.png", "emit.png", "normal.png", "ao.png"});
     const std::string obj = std::string(kQuadObj) + "vn 0 0 1\nf 1/1/1 3/3/1 4/4/1\nusemtl other\nf 1 2 -1\n";
     const std::string mtl = std::string(kQuadMtl) + "newmtl other\nKd 1 1 1\nmap_bump -bm 2 normal.png\n";

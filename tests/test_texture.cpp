@@ -14,39 +14,21 @@
 
 #include <stb_image_write.h>
 
+#include "tests/scratch.h"
+
 #include "shading/texture.h"
 
 namespace fs = std::filesystem;
 using namespace prast;
+using prast::test::TempDir;
+using prast::test::read_bytes;
+using prast::test::write_bytes;
+using prast::test::write_text;
 
 namespace {
 
-// A unique scratch directory, removed with everything in it at scope exit.
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
-        path = fs::temp_directory_path() /
-               ("prast_test_texture_" + std::to_string(stamp) + "_" +
-                std::to_string(reinterpret_cast<std::uintptr_t>(this) & 0xFFFFFF));
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string file(const std::string& name) const { return (path / name).string(); }
-};
 
-std::vector<unsigned char> read_bytes(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    return std::vector<unsigned char>(std::istreambuf_iterator<char>(f), {});
-}
 
-void write_bytes(const std::string& path, const std::vector<unsigned char>& bytes) {
-    std::ofstream f(path, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-}
 
 ImageSource file_source(const std::string& path) {
     ImageSource s;
@@ -354,7 +336,7 @@ TEST_CASE("default texture and invalid images") {
 }
 
 TEST_CASE("decode: sRGB 8-bit RGBA, grey, grey+alpha") {
-    TempDir dir;
+    TempDir dir("texture");
     // 4x1 RGBA with known bytes.
     const unsigned char rgba[16] = {0, 10, 128, 255, 255, 188, 64, 0, 1, 2, 3, 4, 200, 100, 50, 128};
     const std::string path = dir.file("rgba.png");
@@ -414,7 +396,7 @@ TEST_CASE("decode: sRGB 8-bit RGBA, grey, grey+alpha") {
 }
 
 TEST_CASE("decode: 16-bit PNG") {
-    TempDir dir;
+    TempDir dir("texture");
     // 2x2 grey, 16-bit big-endian samples.
     const std::uint16_t values[4] = {0, 1, 32768, 65535};
     std::vector<unsigned char> samples;
@@ -450,7 +432,7 @@ TEST_CASE("decode: 16-bit PNG") {
 }
 
 TEST_CASE("decode: HDR round-trips exactly") {
-    TempDir dir;
+    TempDir dir("texture");
     // RGBE holds 8 mantissa bits per channel with a shared exponent: values
     // of the form k * 2^e with k < 256 and a common e per texel are exact.
     const float hdr[12] = {1.0f, 0.5f, 0.25f, 128.0f, 64.0f, 2.0f, 0.0f, 0.0f, 0.0f, 3.0f, 5.0f, 7.0f};
@@ -471,7 +453,7 @@ TEST_CASE("decode: HDR round-trips exactly") {
 }
 
 TEST_CASE("decode: bad files throw LoadError naming the file") {
-    TempDir dir;
+    TempDir dir("texture");
     require_load_error(file_source(dir.file("missing.png")), "missing.png");
     require_load_error(file_source(dir.path.string()), dir.path.filename().string());
 
@@ -523,7 +505,7 @@ TEST_CASE("decode: bad files throw LoadError naming the file") {
 }
 
 TEST_CASE("decode: randomly corrupted PNG and JPEG never crash") {
-    TempDir dir;
+    TempDir dir("texture");
     unsigned char pixels[16 * 16 * 3];
     for (int i = 0; i < 16 * 16 * 3; ++i) pixels[i] = (unsigned char)((i * 7) ^ (i >> 3));
     const std::string png_path = dir.file("small.png"), jpg_path = dir.file("small.jpg");
