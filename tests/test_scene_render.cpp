@@ -151,3 +151,70 @@ TEST_CASE("real assets render without NaN and are not black") {
     }
 }
 }
+
+TEST_SUITE("scene") {
+
+namespace {
+// A unit quad in the z = 0 plane facing +z, one material, seen from the eye.
+Scene quad_scene(const Material& m) {
+    Scene s;
+    Mesh q;
+    q.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    q.normals.assign(4, glm::vec3(0, 0, 1));
+    q.uvs = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+    q.tangents.assign(4, glm::vec4(1, 0, 0, 1));
+    q.indices = {0, 1, 2, 0, 2, 3};
+    s.meshes.push_back(q);
+    s.materials.push_back(m);
+    return s;
+}
+
+Framebuffer render_quad(const Scene& s, glm::vec3 eye, glm::vec3 towards_light) {
+    Renderer r({1, 64});
+    SceneRenderer sr(s, r);
+    FrameSettings fs;
+    fs.camera.eye = eye;
+    fs.camera.target = glm::vec3(0.0f);
+    fs.camera.near_plane = 0.1f;
+    fs.camera.far_plane = 10.0f;
+    ShadingLight sun;
+    sun.direction = glm::normalize(towards_light);
+    sun.radiance = glm::vec3(2.0f);
+    fs.lights = {sun};
+    fs.ambient = glm::vec3(0.0f);
+    Framebuffer fb(32, 32);
+    sr.render(fs, fb);
+    return fb;
+}
+} // namespace
+
+TEST_CASE("alpha mode MASK discards fragments below the cutoff, keeps those above") {
+    Material m;
+    m.alpha_mode = AlphaMode::Mask;
+    m.alpha_cutoff = 0.5f;
+    m.base_color_factor = glm::vec4(0.8f, 0.8f, 0.8f, 0.3f);
+    Framebuffer below = render_quad(quad_scene(m), {0, 0, 3}, {0, 0, 1});
+    CHECK(below.pixel(16, 16)[0] == 0.0f);
+    CHECK(below.depth[16 * 32 + 16] == 1.0f);  // a discarded fragment writes no depth
+    m.base_color_factor.a = 0.7f;
+    Framebuffer above = render_quad(quad_scene(m), {0, 0, 3}, {0, 0, 1});
+    CHECK(above.pixel(16, 16)[0] > 0.1f);
+    CHECK(above.depth[16 * 32 + 16] < 1.0f);
+}
+
+TEST_CASE("a double-sided material shades its back face with the normal flipped") {
+    Material m;
+    m.double_sided = true;
+    // Seen from behind and lit from behind: the flipped normal faces the light.
+    Framebuffer lit = render_quad(quad_scene(m), {0, 0, -3}, {0, 0, -1});
+    CHECK(lit.pixel(16, 16)[0] > 0.1f);
+    // Seen from behind, lit from the front: the back face is dark.
+    Framebuffer dark = render_quad(quad_scene(m), {0, 0, -3}, {0, 0, 1});
+    CHECK(dark.pixel(16, 16)[0] == 0.0f);
+    CHECK(dark.depth[16 * 32 + 16] < 1.0f);  // drawn, just unlit
+    // Single-sided: the back face is culled.
+    m.double_sided = false;
+    Framebuffer culled = render_quad(quad_scene(m), {0, 0, -3}, {0, 0, -1});
+    CHECK(culled.depth[16 * 32 + 16] == 1.0f);
+}
+}
