@@ -9,6 +9,10 @@
 #include <cstdint>
 #include <cstring>
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 #include "raster/bin.h"
 #include "raster/draw_state.h"
 #include "raster/fragment.h"
@@ -43,21 +47,47 @@ inline std::uint32_t scissor_mask(int bx, int by, int width, int height) {
     return m;
 }
 
-// Per-triangle data prepared once per tile: lane offsets of the edge functions
-// and the varyings of the three vertices as (v0, v1 - v0, v2 - v0).
+// Per-triangle data prepared once per tile: lane offsets of the edge functions,
+// the extremes of each edge function over a 16x16 and a 4x4 block relative to
+// its top-left pixel (classify_block() of setup.h, whose terms do not depend on
+// the block), and the varyings of the three vertices as (v0, v1 - v0, v2 - v0).
 template <int NV>
 struct TriangleInTile {
     std::int64_t lane_offset[3][kBlockLanes];
+    std::int64_t coarse_hi[3], coarse_lo[3], fine_hi[3], fine_lo[3];
     float v0[NV > 0 ? NV : 1], d1[NV > 0 ? NV : 1], d2[NV > 0 ? NV : 1];
 };
+
+// classify_block(t, e, x, y, size) with the block-independent terms taken
+// from TriangleInTile: the same integer sums, hence the same answer.
+inline EdgeClass classify_edge(std::int64_t e0, std::int64_t hi, std::int64_t lo) {
+    if (e0 + hi < 0) return kEdgeOut;
+    if (e0 + lo >= 0) return kEdgeIn;
+    return kEdgePartial;
+}
 
 template <int NV>
 void prepare_triangle(const TriangleSetup& t, const TileContext& ctx, const BinJob& job,
                       TriangleInTile<NV>& p) {
-    for (int e = 0; e < 3; ++e)
-        for (int l = 0; l < kBlockLanes; ++l)
-            p.lane_offset[e][l] = std::int64_t(t.A[e]) * (lane_x(l) * kSubPixelScale) +
-                                  std::int64_t(t.B[e]) * (lane_y(l) * kSubPixelScale);
+    for (int e = 0; e < 3; ++e) {
+        // A x + B y at the lanes' pixel offsets (fragment.h's lane order), by
+        // exact integer sums: quad (qx, qy) adds 2 qx A + 2 qy B to quad 0.
+        typedef std::int64_t Int64x4 __attribute__((vector_size(32)));
+        const std::int64_t a = t.A[e], b = t.B[e];
+        const std::int64_t a1 = a * kSubPixelScale, b1 = b * kSubPixelScale;
+        const Int64x4 quad0 = {0, a1, b1, a1 + b1};
+        const Int64x4 quad1 = quad0 + 2 * a1, quad2 = quad0 + 2 * b1, quad3 = quad1 + 2 * b1;
+        std::memcpy(&p.lane_offset[e][0], &quad0, sizeof quad0);
+        std::memcpy(&p.lane_offset[e][4], &quad1, sizeof quad1);
+        std::memcpy(&p.lane_offset[e][8], &quad2, sizeof quad2);
+        std::memcpy(&p.lane_offset[e][12], &quad3, sizeof quad3);
+        const std::int64_t coarse = std::int64_t(kCoarseBlockSize - 1) * kSubPixelScale;
+        const std::int64_t fine = std::int64_t(kBlockSize - 1) * kSubPixelScale;
+        p.coarse_hi[e] = (a > 0 ? a : 0) * coarse + (b > 0 ? b : 0) * coarse;
+        p.coarse_lo[e] = (a < 0 ? a : 0) * coarse + (b < 0 ? b : 0) * coarse;
+        p.fine_hi[e] = (a > 0 ? a : 0) * fine + (b > 0 ? b : 0) * fine;
+        p.fine_lo[e] = (a < 0 ? a : 0) * fine + (b < 0 ? b : 0) * fine;
+    }
     const float* v[3];
     for (int i = 0; i < 3; ++i) {
         std::uint32_t r = t.vtx[i];
@@ -71,6 +101,56 @@ void prepare_triangle(const TriangleSetup& t, const TileContext& ctx, const BinJ
     }
 }
 
+// Eight floats with lane-wise IEEE arithmetic (the GCC/Clang vector
+// extension), for the block loops that the auto-vectoriser gets wrong: given
+// the interpolation loop, it vectorises across varyings and transposes. Only
+// ever a local variable: as a parameter or return value by value its ABI would
+// depend on AVX (-Wpsabi).
+typedef float Lanes8 __attribute__((vector_size(32)));
+inline void load_lanes(Lanes8& v, const float* p) { std::memcpy(&v, p, sizeof v); }
+inline void store_lanes(float* p, const Lanes8& v) { std::memcpy(p, &v, sizeof v); }
+
+// Offset of lane l's pixel from the block's top-left pixel, in a row-major
+// buffer `width` pixels wide. Lanes 2j and 2j + 1 are neighbours in one row.
+inline std::size_t lane_offset_in(int width, int l) {
+    return std::size_t(lane_y(l)) * std::size_t(width) + std::size_t(lane_x(l));
+}
+
+// Lane masks from comparisons. The compiler unrolls these loops and tests
+// lane by lane, so with AVX2 they are written with the sign-mask instructions.
+// Bit l: a[l] < b[l] (false for NaN).
+inline std::uint32_t less_mask(const float* a, const float* b) {
+#if defined(__AVX2__)
+    std::uint32_t m = 0;
+    for (int h = 0; h < kBlockLanes; h += 8)
+        m |= std::uint32_t(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(a + h), _mm256_loadu_ps(b + h),
+                                                            _CMP_LT_OQ))) << h;
+    return m;
+#else
+    std::uint32_t m = 0;
+    for (int l = 0; l < kBlockLanes; ++l) m |= std::uint32_t(a[l] < b[l]) << l;
+    return m;
+#endif
+}
+
+// Bit l: e0 + offset[l] >= 0 (no overflow: edge values stay below 2^60).
+inline std::uint32_t nonnegative_mask(std::int64_t e0, const std::int64_t* offset) {
+#if defined(__AVX2__)
+    const __m256i e = _mm256_set1_epi64x(e0);
+    std::uint32_t negative = 0;
+    for (int h = 0; h < kBlockLanes; h += 4) {
+        const __m256i v =
+            _mm256_add_epi64(e, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(offset + h)));
+        negative |= std::uint32_t(_mm256_movemask_pd(_mm256_castsi256_pd(v))) << h;
+    }
+    return ~negative & 0xFFFFu;
+#else
+    std::uint32_t m = 0;
+    for (int l = 0; l < kBlockLanes; ++l) m |= std::uint32_t(e0 + offset[l] >= 0) << l;
+    return m;
+#endif
+}
+
 // Depth test, interpolation, shading and write-back of one 4x4 block.
 template <class Program, class Observer>
 void shade_block(const Program& program, const TileContext& ctx, const TriangleSetup& t,
@@ -80,6 +160,7 @@ void shade_block(const Program& program, const TileContext& ctx, const TriangleS
     Framebuffer& fb = *ctx.fb;
     const DrawState& st = *ctx.state;
     const bool full = bx + kBlockSize <= fb.width && by + kBlockSize <= fb.height;
+    const std::size_t block_offset = std::size_t(by) * std::size_t(fb.width) + std::size_t(bx);
 
     // Screen-space barycentrics from the anchored planes, then depth.
     alignas(64) float b0[kBlockLanes], b1[kBlockLanes], b2[kBlockLanes];
@@ -94,40 +175,42 @@ void shade_block(const Program& program, const TileContext& ctx, const TriangleS
         in.z[l] = std::min(std::max(z, 0.0f), 1.0f);
     }
 
-    // Early depth test (the shader never writes depth).
+    // Early depth test (the shader never writes depth): the buffer's depths in
+    // lane order, then one vector compare.
     std::uint32_t pass = mask;
     if (st.depth_test) {
-        std::uint32_t less = 0;
+        alignas(64) float d[kBlockLanes];
+        const float* depth = &fb.depth[block_offset];
         if (full) {
-            for (int l = 0; l < kBlockLanes; ++l) {
-                float d = fb.depth[std::size_t(by + lane_y(l)) * fb.width + bx + lane_x(l)];
-                less |= std::uint32_t(in.z[l] < d) << l;
-            }
+            for (int l = 0; l < kBlockLanes; l += 2)
+                std::memcpy(&d[l], depth + lane_offset_in(fb.width, l), 2 * sizeof(float));
         } else {
             for (int l = 0; l < kBlockLanes; ++l)
-                if (mask & (1u << l)) {
-                    float d = fb.depth[std::size_t(by + lane_y(l)) * fb.width + bx + lane_x(l)];
-                    less |= std::uint32_t(in.z[l] < d) << l;
-                }
+                d[l] = (mask & (1u << l)) ? depth[lane_offset_in(fb.width, l)] : 0.0f;
         }
-        pass &= less;
+        pass &= less_mask(in.z, d);
     }
     stats.fragments_covered += popcount16(mask);
     stats.fragments_depth_killed += popcount16(mask & ~pass);
     if constexpr (Observer::enabled) obs.fragments(t.prim_id, bx, by, mask, pass, in.z);
     if (!pass) return;
 
-    // Perspective-correct weights: screen barycentrics over w, renormalised.
-    alignas(64) float w1[kBlockLanes], w2[kBlockLanes];
-    for (int l = 0; l < kBlockLanes; ++l) {
-        float q0 = b0[l] * t.inv_w[0], q1 = b1[l] * t.inv_w[1], q2 = b2[l] * t.inv_w[2];
-        float s = 1.0f / (q0 + q1 + q2);
-        w1[l] = q1 * s;
-        w2[l] = q2 * s;
-    }
-    for (int k = 0; k < NV; ++k) {
-        const float v0 = p.v0[k], d1 = p.d1[k], d2 = p.d2[k];
-        for (int l = 0; l < kBlockLanes; ++l) in.var[k][l] = v0 + w1[l] * d1 + w2[l] * d2;
+    // Perspective-correct weights: screen barycentrics over w, renormalised;
+    // then every varying, eight lanes at a time.
+    for (int h = 0; h < kBlockLanes; h += 8) {
+        Lanes8 q0, q1, q2;
+        load_lanes(q0, b0 + h);
+        load_lanes(q1, b1 + h);
+        load_lanes(q2, b2 + h);
+        q0 = q0 * t.inv_w[0];
+        q1 = q1 * t.inv_w[1];
+        q2 = q2 * t.inv_w[2];
+        const Lanes8 s = 1.0f / (q0 + q1 + q2);
+        const Lanes8 w1 = q1 * s, w2 = q2 * s;
+        for (int k = 0; k < NV; ++k) {
+            const Lanes8 v = p.v0[k] + w1 * p.d1[k] + w2 * p.d2[k];
+            store_lanes(in.var[k] + h, v);
+        }
     }
     in.x = bx;
     in.y = by;
@@ -145,16 +228,57 @@ void shade_block(const Program& program, const TileContext& ctx, const TriangleS
     if constexpr (Observer::enabled) obs.shaded(in, out, live);
 
     // Write-back.
-    for (int l = 0; l < kBlockLanes; ++l) {
-        if (!(live & (1u << l))) continue;
-        std::size_t idx = std::size_t(by + lane_y(l)) * fb.width + bx + lane_x(l);
-        if (st.depth_write) fb.depth[idx] = in.z[l];
-        float* c = &fb.color[idx * 4];
-        if (st.blend == Blend::Add) {
+    float* depth = &fb.depth[block_offset];
+    float* color = &fb.color[block_offset * 4];
+    if (st.blend == Blend::Add) {
+        for (std::uint32_t m = live; m; m &= m - 1) {
+            const int l = __builtin_ctz(m);
+            const std::size_t o = lane_offset_in(fb.width, l);
+            if (st.depth_write) depth[o] = in.z[l];
+            float* c = color + o * 4;
             c[0] += out.r[l]; c[1] += out.g[l]; c[2] += out.b[l]; c[3] += out.a[l];
-        } else {
-            c[0] = out.r[l]; c[1] = out.g[l]; c[2] = out.b[l]; c[3] = out.a[l];
         }
+        return;
+    }
+    if (live == 0xFFFFu) {
+        // Every pixel: lanes 2j and 2j + 1 are neighbours in a row, written
+        // as one pair of RGBA pixels.
+        if (st.depth_write)
+            for (int l = 0; l < kBlockLanes; l += 2)
+                std::memcpy(depth + lane_offset_in(fb.width, l), &in.z[l], 2 * sizeof(float));
+#if defined(__AVX2__)
+        for (int h = 0; h < kBlockLanes; h += 8) {
+            const __m256 r = _mm256_load_ps(out.r + h), g = _mm256_load_ps(out.g + h);
+            const __m256 b = _mm256_load_ps(out.b + h), a = _mm256_load_ps(out.a + h);
+            // Interleave: RGBA of lane h + i in the half of p[i % 4] given by i / 4.
+            const __m256d rg_lo = _mm256_castps_pd(_mm256_unpacklo_ps(r, g));
+            const __m256d ba_lo = _mm256_castps_pd(_mm256_unpacklo_ps(b, a));
+            const __m256d rg_hi = _mm256_castps_pd(_mm256_unpackhi_ps(r, g));
+            const __m256d ba_hi = _mm256_castps_pd(_mm256_unpackhi_ps(b, a));
+            const __m256 p0 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_lo, ba_lo));
+            const __m256 p1 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_lo, ba_lo));
+            const __m256 p2 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_hi, ba_hi));
+            const __m256 p3 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_hi, ba_hi));
+            _mm256_storeu_ps(color + lane_offset_in(fb.width, h) * 4, _mm256_permute2f128_ps(p0, p1, 0x20));
+            _mm256_storeu_ps(color + lane_offset_in(fb.width, h + 2) * 4, _mm256_permute2f128_ps(p2, p3, 0x20));
+            _mm256_storeu_ps(color + lane_offset_in(fb.width, h + 4) * 4, _mm256_permute2f128_ps(p0, p1, 0x31));
+            _mm256_storeu_ps(color + lane_offset_in(fb.width, h + 6) * 4, _mm256_permute2f128_ps(p2, p3, 0x31));
+        }
+#else
+        for (int l = 0; l < kBlockLanes; l += 2) {
+            const float pair[8] = {out.r[l], out.g[l], out.b[l], out.a[l],
+                                   out.r[l + 1], out.g[l + 1], out.b[l + 1], out.a[l + 1]};
+            std::memcpy(color + lane_offset_in(fb.width, l) * 4, pair, sizeof pair);
+        }
+#endif
+        return;
+    }
+    for (std::uint32_t m = live; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        const std::size_t o = lane_offset_in(fb.width, l);
+        if (st.depth_write) depth[o] = in.z[l];
+        float* c = color + o * 4;
+        c[0] = out.r[l]; c[1] = out.g[l]; c[2] = out.b[l]; c[3] = out.a[l];
     }
 }
 
@@ -165,10 +289,7 @@ inline std::uint32_t block_coverage(const TriangleSetup& t, const TriangleInTile
     std::uint32_t mask = 0xFFFFu;
     for (int e = 0; e < 3; ++e) {
         if (!(partial_edges & (1u << e))) continue;
-        std::int64_t e0 = edge_at_pixel(t, e, bx, by);
-        std::uint32_t m = 0;
-        for (int l = 0; l < kBlockLanes; ++l) m |= std::uint32_t(e0 + p.lane_offset[e][l] >= 0) << l;
-        mask &= m;
+        mask &= nonnegative_mask(edge_at_pixel(t, e, bx, by), p.lane_offset[e]);
     }
     return mask;
 }
@@ -194,7 +315,7 @@ void rasterize_triangle(const Program& program, const TileContext& ctx, const Tr
             unsigned partial = 0;
             bool out = false;
             for (int e = 0; e < 3 && !out; ++e) {
-                EdgeClass c = classify_block(t, e, cx, cy, kCoarseBlockSize);
+                EdgeClass c = classify_edge(edge_at_pixel(t, e, cx, cy), p.coarse_hi[e], p.coarse_lo[e]);
                 if (c == kEdgeOut) out = true;
                 else if (c == kEdgePartial) partial |= 1u << e;
             }
@@ -213,7 +334,7 @@ void rasterize_triangle(const Program& program, const TileContext& ctx, const Tr
                         bool block_out = false;
                         for (int e = 0; e < 3 && !block_out; ++e) {
                             if (!(partial & (1u << e))) continue;
-                            EdgeClass c = classify_block(t, e, bx, by, kBlockSize);
+                            EdgeClass c = classify_edge(edge_at_pixel(t, e, bx, by), p.fine_hi[e], p.fine_lo[e]);
                             if (c == kEdgeOut) block_out = true;
                             else if (c == kEdgePartial) block_partial |= 1u << e;
                         }
@@ -239,6 +360,14 @@ void rasterize_tile(const Program& program, const TileContext& ctx, int tile, Fr
     const TileGrid& g = *ctx.grid;
     int tx0 = (tile % g.tiles_x) * g.tile_size, ty0 = (tile / g.tiles_x) * g.tile_size;
     int tx1 = std::min(tx0 + g.tile_size, g.width) - 1, ty1 = std::min(ty0 + g.tile_size, g.height) - 1;
+    // The depth test reads the tile's depths first: ask for them all now, so
+    // that the cache misses overlap instead of stalling block after block.
+    const Framebuffer& fb = *ctx.fb;
+    for (int y = ty0; y <= ty1; ++y) {
+        const float* row = &fb.depth[std::size_t(y) * std::size_t(fb.width)];
+        for (int x = tx0; x <= tx1; x += 16) __builtin_prefetch(row + x);
+        __builtin_prefetch(row + tx1);
+    }
     bool touched = false;
     for (int j = 0; j < ctx.job_count; ++j) {
         const BinJob& job = ctx.jobs[j];

@@ -1,10 +1,11 @@
-// The lighting sum of shade_surface() for the 16 lanes of a 4x4 block at once,
-// in structure-of-arrays form: each step is a loop over lanes with no branch
-// (selects only), which the compiler vectorises. Every lane performs exactly
-// the float operations of the scalar evaluate_brdf()/shade_surface(), in the
-// same order (the build has no FMA contraction), so the two paths give
-// bit-identical results: tests/test_light_block.cpp holds them to that, and
-// the stepper can explain a pixel with the scalar code.
+// The lighting sum of shade_surface() for the lanes of a 4x4 block at once (all
+// 16, or the first 4 or 8 when the fragment program packs the live lanes of a
+// sparse block), in structure-of-arrays form: each step is a loop over lanes
+// with no branch (selects only), which the compiler vectorises. Every lane
+// performs exactly the float operations of the scalar evaluate_brdf() /
+// shade_surface(), in the same order (the build has no FMA contraction), so
+// the two paths give bit-identical results: tests/test_light_block.cpp holds
+// them to that, and the stepper can explain a pixel with the scalar code.
 // Conductor (complex-index) materials are not handled here: the fragment
 // program shades them with the scalar path.
 #pragma once
@@ -31,41 +32,36 @@ struct RadianceBlock {
     alignas(64) float r[kBlockLanes], g[kBlockLanes], b[kBlockLanes];
 };
 
-// One light's contribution f * radiance * n.l, added to out.
-template <bool Point, bool Gltf>
+// One light's contribution f * radiance * n.l, added to out, for the first N
+// lanes (the fragment program packs the live lanes of a sparse block first).
+template <bool Point, bool Gltf, int N = kBlockLanes>
 inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L,
                         const float* __restrict vx, const float* __restrict vy, const float* __restrict vz,
                         const float* __restrict F0r, const float* __restrict F0g, const float* __restrict F0b,
                         const float* __restrict alpha, const float* __restrict kdir,
                         RadianceBlock& __restrict out) {
-    constexpr int N = kBlockLanes;
+    static_assert(N % 4 == 0 && N <= kBlockLanes, "whole vectors of lanes");
     const float eps = kBrdfMinCos;
     // Uniforms out of the loop, so that it reads only lane arrays.
     const float Lpx = L.position.x, Lpy = L.position.y, Lpz = L.position.z;
     const float Ldx = L.direction.x, Ldy = L.direction.y, Ldz = L.direction.z;
     const float Lr = L.radiance.x, Lg = L.radiance.y, Lb = L.radiance.z;
-    // Light direction and radiance at P (light_at).
-    alignas(64) float Lx[N], Ly[N], Lz[N], Rr_[N], Rg_[N], Rb_[N];
     for (int l = 0; l < N; ++l) {
+        // Light direction and radiance at P (light_at).
+        float lx = Ldx, ly = Ldy, lz = Ldz, Rr = Lr, Rg = Lg, Rb = Lb;
         if constexpr (Point) {
             float dx = Lpx - m.Px[l], dy = Lpy - m.Py[l], dz = Lpz - m.Pz[l];
             float d2 = dx * dx + dy * dy + dz * dz;
             bool ok = d2 > 1e-12f;
             float s = std::sqrt(ok ? d2 : 1.0f);
             float dd = ok ? d2 : 1.0f;
-            Lx[l] = ok ? dx / s : 0.0f;
-            Ly[l] = ok ? dy / s : 0.0f;
-            Lz[l] = ok ? dz / s : 1.0f;
-            Rr_[l] = ok ? Lr / dd : 0.0f;
-            Rg_[l] = ok ? Lg / dd : 0.0f;
-            Rb_[l] = ok ? Lb / dd : 0.0f;
-        } else {
-            Lx[l] = Ldx; Ly[l] = Ldy; Lz[l] = Ldz;
-            Rr_[l] = Lr; Rg_[l] = Lg; Rb_[l] = Lb;
+            lx = ok ? dx / s : 0.0f;
+            ly = ok ? dy / s : 0.0f;
+            lz = ok ? dz / s : 1.0f;
+            Rr = ok ? Lr / dd : 0.0f;
+            Rg = ok ? Lg / dd : 0.0f;
+            Rb = ok ? Lb / dd : 0.0f;
         }
-    }
-    for (int l = 0; l < N; ++l) {
-        const float lx = Lx[l], ly = Ly[l], lz = Lz[l], Rr = Rr_[l], Rg = Rg_[l], Rb = Rb_[l];
         // Cosines and h.
         float hx = lx + vx[l], hy = ly + vy[l], hz = lz + vz[l];
         float hl2 = hx * hx + hy * hy + hz * hz;
@@ -107,15 +103,21 @@ inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L
     }
 }
 
-inline void shade_block_lanes(const MaterialBlock& m, const ShadingContext& ctx, RadianceBlock& out) {
-    constexpr int N = kBlockLanes;
+// shade_surface() for the first N lanes of m.
+template <int N = kBlockLanes>
+inline void shade_block_lanes(const MaterialBlock& __restrict m, const ShadingContext& ctx,
+                              RadianceBlock& __restrict out) {
+    static_assert(N % 4 == 0 && N <= kBlockLanes, "whole vectors of lanes");
     const bool gltf = ctx.model == BrdfModel::Gltf;
     alignas(64) float vx[N], vy[N], vz[N], F0r[N], F0g[N], F0b[N], alpha[N], kdir[N];
     const float f0 = f0_from_ior(m.ior);
+    // Uniforms out of the loops, so that they read only lane arrays.
+    const float ex = ctx.eye.x, ey = ctx.eye.y, ez = ctx.eye.z;
+    const float amb_r = ctx.ambient.x, amb_g = ctx.ambient.y, amb_b = ctx.ambient.z;
 
     // View direction (safe_normalize with the normal as fallback), F0, alpha, k.
     for (int l = 0; l < N; ++l) {
-        float dx = ctx.eye.x - m.Px[l], dy = ctx.eye.y - m.Py[l], dz = ctx.eye.z - m.Pz[l];
+        float dx = ex - m.Px[l], dy = ey - m.Py[l], dz = ez - m.Pz[l];
         float len2 = dx * dx + dy * dy + dz * dz;
         bool ok = (len2 > 1e-20f) & (len2 <= 3.402823466e38f);
         float s = std::sqrt(ok ? len2 : 1.0f);
@@ -139,17 +141,17 @@ inline void shade_block_lanes(const MaterialBlock& m, const ShadingContext& ctx,
 
     for (const ShadingLight& L : ctx.lights) {
         if (L.point) {
-            if (gltf) light_lanes<true, true>(m, L, vx, vy, vz, F0r, F0g, F0b, alpha, kdir, out);
-            else light_lanes<true, false>(m, L, vx, vy, vz, F0r, F0g, F0b, alpha, kdir, out);
+            if (gltf) light_lanes<true, true, N>(m, L, vx, vy, vz, F0r, F0g, F0b, alpha, kdir, out);
+            else light_lanes<true, false, N>(m, L, vx, vy, vz, F0r, F0g, F0b, alpha, kdir, out);
         } else {
-            if (gltf) light_lanes<false, true>(m, L, vx, vy, vz, F0r, F0g, F0b, alpha, kdir, out);
-            else light_lanes<false, false>(m, L, vx, vy, vz, F0r, F0g, F0b, alpha, kdir, out);
+            if (gltf) light_lanes<false, true, N>(m, L, vx, vy, vz, F0r, F0g, F0b, alpha, kdir, out);
+            else light_lanes<false, false, N>(m, L, vx, vy, vz, F0r, F0g, F0b, alpha, kdir, out);
         }
     }
     for (int l = 0; l < N; ++l) {
-        out.r[l] += ctx.ambient.x * m.ar[l] * m.occlusion[l];
-        out.g[l] += ctx.ambient.y * m.ag[l] * m.occlusion[l];
-        out.b[l] += ctx.ambient.z * m.ab[l] * m.occlusion[l];
+        out.r[l] += amb_r * m.ar[l] * m.occlusion[l];
+        out.g[l] += amb_g * m.ag[l] * m.occlusion[l];
+        out.b[l] += amb_b * m.ab[l] * m.occlusion[l];
     }
 }
 

@@ -1,10 +1,18 @@
-// The PBR fragment stage; see pbr_program.h. One call per 4x4 block: the loop
-// over lanes lives here so that sample_material/shade_surface inline into it.
+// The PBR fragment stage; see pbr_program.h. One call per 4x4 block. The lit
+// image takes the 16-lane path (shade_lanes); debug views and conductor
+// materials loop over the lanes with the scalar sample_material() and
+// shade_surface() inlined, the functions the stepper explains pixels with.
 #include "shading/pbr_program.h"
 
 #include "shading/light_block.h"
+#include "shading/material_lanes.h"
 
+#include <algorithm>
 #include <cmath>
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
 
 namespace prast {
 
@@ -51,24 +59,101 @@ BrdfTerms first_light_terms(const MaterialSample& ms, const SurfacePoint& sp, co
 
 } // namespace
 
+// The lit path (material_lanes.h, then light_block.h) for a block's live
+// lanes, either in place (N = 16) or packed into the first N = 4 or 8 lanes:
+// half the blocks of a typical frame have at most 4 live lanes (small
+// triangles, edges), and a lane costs the same whether live or not. Each lane
+// does the float operations of sample_material() and shade_surface().
+template <int N>
+void PbrProgram::shade_lanes(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
+    SurfaceLanes s;
+    const float* var[kVaryings];
+    std::uint32_t live = in.mask;
+    // Packed lane i holds block lane lane[i], of quad quad[i]; the spare
+    // packed lanes repeat the first live lane (valid inputs, results dropped).
+    std::uint8_t lane[N] = {}, quad[N] = {};
+    alignas(64) float packed[kVaryings][N];
+    if constexpr (N == kBlockLanes) {
+        for (int k = 0; k < kVaryings; ++k) var[k] = in.var[k];
+    } else {
+        static_assert(N == 4 || N == 8, "packed blocks have 4 or 8 lanes");
+        int n = 0;
+        for (std::uint32_t m = in.mask; m && n < N; m &= m - 1) lane[n++] = std::uint8_t(__builtin_ctz(m));
+        live = (1u << n) - 1u;
+        for (int l = n; l < N; ++l) lane[l] = lane[0];
+        for (int l = 0; l < N; ++l) quad[l] = std::uint8_t(lane[l] >> 2);
+#if defined(__AVX2__)
+        // Each varying: both halves permuted, then blended.
+        alignas(32) std::int32_t index[8];
+        for (int l = 0; l < 8; ++l) index[l] = lane[l < N ? l : 0];
+        const __m256i idx = _mm256_load_si256(reinterpret_cast<const __m256i*>(index));
+        const __m256 from_high = _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7)));
+        for (int k = 0; k < kVaryings; ++k) {
+            const __m256 lo = _mm256_permutevar8x32_ps(_mm256_load_ps(in.var[k]), idx);
+            const __m256 hi = _mm256_permutevar8x32_ps(_mm256_load_ps(in.var[k] + 8), idx);
+            const __m256 v = _mm256_blendv_ps(lo, hi, from_high);
+            if constexpr (N == 8) _mm256_store_ps(packed[k], v);
+            else _mm_store_ps(packed[k], _mm256_castps256_ps128(v));
+        }
+#else
+        for (int k = 0; k < kVaryings; ++k)
+            for (int l = 0; l < N; ++l) packed[k][l] = in.var[k][lane[l]];
+#endif
+        for (int k = 0; k < kVaryings; ++k) var[k] = packed[k];
+        s.quad = quad;
+    }
+    s.Px = var[kVarP]; s.Py = var[kVarP + 1]; s.Pz = var[kVarP + 2];
+    s.Nx = var[kVarN]; s.Ny = var[kVarN + 1]; s.Nz = var[kVarN + 2];
+    s.Tx = var[kVarT]; s.Ty = var[kVarT + 1]; s.Tz = var[kVarT + 2]; s.Tw = var[kVarT + 3];
+    s.u = var[kVarUV]; s.v = var[kVarUV + 1];
+    for (int q = 0; q < 4; ++q) {
+        const int l = 4 * q;  // the quad's derivatives, as surface_point() takes them
+        s.dudx[q] = in.ddx(kVarUV, l); s.dvdx[q] = in.ddx(kVarUV + 1, l);
+        s.dudy[q] = in.ddy(kVarUV, l); s.dvdy[q] = in.ddy(kVarUV + 1, l);
+    }
+    s.front_facing = in.front_facing;
+
+    MaterialBlock mb;
+    const std::uint32_t kill = sample_material_lanes<N>(*material, s, live, mb);
+    RadianceBlock rb;
+    shade_block_lanes<N>(mb, *ctx, rb);
+
+    if constexpr (N == kBlockLanes) {
+        out.kill = kill;
+        for (int l = 0; l < N; ++l) {
+            out.r[l] = rb.r[l]; out.g[l] = rb.g[l]; out.b[l] = rb.b[l]; out.a[l] = 1.0f;
+        }
+    } else {
+        std::fill(out.r, out.r + kBlockLanes, 0.0f);
+        std::fill(out.g, out.g + kBlockLanes, 0.0f);
+        std::fill(out.b, out.b + kBlockLanes, 0.0f);
+        std::fill(out.a, out.a + kBlockLanes, 1.0f);
+        std::uint32_t block_kill = 0;
+        for (std::uint32_t m = live; m; m &= m - 1) {
+            const int i = __builtin_ctz(m), l = lane[i];
+            out.r[l] = rb.r[i]; out.g[l] = rb.g[i]; out.b[l] = rb.b[i];
+            block_kill |= ((kill >> i) & 1u) << l;
+        }
+        out.kill = block_kill;
+    }
+}
+
 void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
     const Material& m = *material->m;
+    // The lit path samples the material and lights the lanes together, packed
+    // when few are live; debug views and conductor materials go lane by lane.
+    if ((view == DebugView::None || view == DebugView::Tiles) && m.conductor == Conductor::None) {
+        const int live = __builtin_popcount(in.mask);
+        if (live > 8) shade_lanes<16>(in, out);
+        else if (live > 4) shade_lanes<8>(in, out);
+        else shade_lanes<4>(in, out);
+        return;
+    }
+
     const bool alpha_mask = m.alpha_mode == AlphaMode::Mask;
-    // The lit path batches the lighting of all lanes (light_block.h); debug
-    // views and conductor materials shade lane by lane.
-    const bool batched = (view == DebugView::None || view == DebugView::Tiles) && m.conductor == Conductor::None;
-    MaterialBlock mb;
     MaterialLods lods;
     for (int l = 0; l < kBlockLanes; ++l) {
         out.r[l] = 0.0f; out.g[l] = 0.0f; out.b[l] = 0.0f; out.a[l] = 1.0f;
-        if (batched) {
-            // Dead lanes get harmless inputs; their results are never written.
-            mb.Px[l] = in.var[kVarP][l]; mb.Py[l] = in.var[kVarP + 1][l]; mb.Pz[l] = in.var[kVarP + 2][l];
-            mb.Nx[l] = 0.0f; mb.Ny[l] = 0.0f; mb.Nz[l] = 1.0f;
-            mb.ar[l] = mb.ag[l] = mb.ab[l] = 0.0f;
-            mb.metallic[l] = 0.0f; mb.roughness[l] = 1.0f; mb.occlusion[l] = 1.0f;
-            mb.er[l] = mb.eg[l] = mb.eb[l] = 0.0f;
-        }
         if (!(in.mask & (1u << l))) continue;
         SurfacePoint sp = surface_point(in, l);
         // The quad's lanes share derivatives, hence levels of detail: compute
@@ -78,14 +163,6 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
         MaterialSample ms = sample_material(*material, sp, lods);
         if (alpha_mask && !(ms.alpha >= m.alpha_cutoff)) {
             out.kill |= 1u << l;
-            continue;
-        }
-        if (batched) {
-            mb.Nx[l] = ms.N.x; mb.Ny[l] = ms.N.y; mb.Nz[l] = ms.N.z;
-            mb.ar[l] = ms.albedo.r; mb.ag[l] = ms.albedo.g; mb.ab[l] = ms.albedo.b;
-            mb.metallic[l] = ms.metallic; mb.roughness[l] = ms.roughness; mb.occlusion[l] = ms.occlusion;
-            mb.er[l] = ms.emissive.r; mb.eg[l] = ms.emissive.g; mb.eb[l] = ms.emissive.b;
-            mb.ior = ms.ior;
             continue;
         }
         glm::vec3 c;
@@ -114,13 +191,6 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
         case DebugView::Specular: c = sum_lobes(ms, sp, *ctx, true); break;
         }
         out.r[l] = c.r; out.g[l] = c.g; out.b[l] = c.b;
-    }
-    if (batched) {
-        RadianceBlock rb;
-        shade_block_lanes(mb, *ctx, rb);
-        for (int l = 0; l < kBlockLanes; ++l) {
-            out.r[l] = rb.r[l]; out.g[l] = rb.g[l]; out.b[l] = rb.b[l];
-        }
     }
 }
 

@@ -55,6 +55,10 @@ struct PbrProgram {
     }
 
     void fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const;
+
+private:
+    template <int N>
+    void shade_lanes(const FragmentBlock<kVaryings>& in, FragmentOut& out) const;
 };
 
 } // namespace prast

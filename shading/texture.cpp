@@ -240,6 +240,20 @@ Image decode_image(const ImageSource& src, bool srgb) {
 
 // ---- Texture
 
+// The samplers for each (wrap_s, wrap_t), indexed by the Wrap enumerators.
+static_assert(int(Wrap::Repeat) == 0 && int(Wrap::ClampToEdge) == 1 && int(Wrap::MirroredRepeat) == 2);
+namespace {
+constexpr Wrap kR = Wrap::Repeat, kC = Wrap::ClampToEdge, kM = Wrap::MirroredRepeat;
+} // namespace
+const Texture::Sampler Texture::kTrilinear[3][3] = {
+    {&Texture::trilinear_wrapped<kR, kR>, &Texture::trilinear_wrapped<kR, kC>, &Texture::trilinear_wrapped<kR, kM>},
+    {&Texture::trilinear_wrapped<kC, kR>, &Texture::trilinear_wrapped<kC, kC>, &Texture::trilinear_wrapped<kC, kM>},
+    {&Texture::trilinear_wrapped<kM, kR>, &Texture::trilinear_wrapped<kM, kC>, &Texture::trilinear_wrapped<kM, kM>}};
+const Texture::LevelSampler Texture::kBilinear[3][3] = {
+    {&Texture::bilinear_wrapped<kR, kR>, &Texture::bilinear_wrapped<kR, kC>, &Texture::bilinear_wrapped<kR, kM>},
+    {&Texture::bilinear_wrapped<kC, kR>, &Texture::bilinear_wrapped<kC, kC>, &Texture::bilinear_wrapped<kC, kM>},
+    {&Texture::bilinear_wrapped<kM, kR>, &Texture::bilinear_wrapped<kM, kC>, &Texture::bilinear_wrapped<kM, kM>}};
+
 Texture::Texture() {
     texels_.assign(1, glm::vec4(1.0f));
     levels_[0] = Level{1, 1, 1.0f, 1.0f, 0};

@@ -77,6 +77,10 @@ public:
     glm::vec4 texel(int level, int x, int y) const;
     // The mean colour of the image: the last (1x1) level.
     glm::vec4 average() const { return texel(level_count_ - 1, 0, 0); }
+    // The texels of every level, level 0 first, each row-major; level k starts
+    // at level_offset(k). For the 4x4-block sampler (sample_lanes.h).
+    const glm::vec4* texel_data() const { return texels_.data(); }
+    std::size_t level_offset(int level) const { return levels_[clamp_level(level)].offset; }
 
     // lambda = log2(rho), rho = max(sqrt((dudx w)^2 + (dvdx h)^2),
     // sqrt((dudy w)^2 + (dvdy h)^2)) with the level-0 size w x h. The result is
@@ -104,9 +108,15 @@ private:
     int clamp_level(int level) const {
         return level < 0 ? 0 : (level >= level_count_ ? level_count_ - 1 : level);
     }
-    static float reduce(float c, Wrap wrap);
-    static int wrap_index(int i, int n, Wrap wrap);
-    glm::vec4 bilinear_reduced(float u, float v, int level) const;
+    // The samplers with the wrap modes fixed at compile time; the public ones
+    // dispatch to them through a table, once per call.
+    template <Wrap S, Wrap T> glm::vec4 bilinear_reduced(float u, float v, int level) const;
+    template <Wrap S, Wrap T> glm::vec4 bilinear_wrapped(float u, float v, int level) const;
+    template <Wrap S, Wrap T> glm::vec4 trilinear_wrapped(float u, float v, float lambda) const;
+    using Sampler = glm::vec4 (Texture::*)(float, float, float) const;
+    using LevelSampler = glm::vec4 (Texture::*)(float, float, int) const;
+    static const Sampler kTrilinear[3][3];
+    static const LevelSampler kBilinear[3][3];
 
     std::vector<glm::vec4> texels_;  // all levels, level 0 first, row-major
     Level levels_[kMaxLevels];
@@ -131,36 +141,42 @@ Image make_tiles_roughness_metal(int size);
 
 // ---- Inline sampling (the per-pixel hot path).
 
+namespace texture_detail {
+
 // Folds a texture coordinate into one period of its wrap mode, so that the
 // texel index computed from it stays in [-1, 2 * size] and converts to int
 // safely: Repeat -> [0, 1], MirroredRepeat -> [0, 2], ClampToEdge -> [0, 1]
 // (clamping u to [0, 1] gives the same texels as clamping the index).
-// NaN and +-Inf become 0.
-inline float Texture::reduce(float c, Wrap wrap) {
-    if (!(std::fabs(c) <= 3.402823466e38f)) c = 0.0f;  // NaN or Inf
-    switch (wrap) {
-    case Wrap::Repeat: return c - std::floor(c);
-    case Wrap::MirroredRepeat: return c - 2.0f * std::floor(c * 0.5f);
-    case Wrap::ClampToEdge: break;
-    }
-    return c < 0.0f ? 0.0f : (c > 1.0f ? 1.0f : c);
+// NaN and +-Inf become 0. Branch-free after inlining, so that the block
+// sampler's lane loops (sample_lanes.h) vectorise with the same operations.
+template <Wrap W>
+inline float reduce(float c) {
+    c = std::fabs(c) <= 3.402823466e38f ? c : 0.0f;  // NaN or Inf
+    if constexpr (W == Wrap::Repeat) return c - std::floor(c);
+    if constexpr (W == Wrap::MirroredRepeat) return c - 2.0f * std::floor(c * 0.5f);
+    c = c < 0.0f ? 0.0f : c;
+    return c > 1.0f ? 1.0f : c;
 }
 
 // Maps a texel index in [-1, 2n] (guaranteed by reduce()) into [0, n).
-inline int Texture::wrap_index(int i, int n, Wrap wrap) {
-    switch (wrap) {
-    case Wrap::Repeat:
-        if (i < 0) return i + n;
+template <Wrap W>
+inline int wrap_index(int i, int n) {
+    if constexpr (W == Wrap::Repeat) {
+        i = i < 0 ? i + n : i;
         return i >= n ? i - n : i;
-    case Wrap::MirroredRepeat:
-        if (i < 0) i = -1 - i;         // mirror image of -1 is 0
-        if (i >= 2 * n) i -= 2 * n;    // period 2n
-        return i >= n ? 2 * n - 1 - i : i;
-    case Wrap::ClampToEdge: break;
     }
-    return i < 0 ? 0 : (i >= n ? n - 1 : i);
+    if constexpr (W == Wrap::MirroredRepeat) {
+        i = i < 0 ? -1 - i : i;          // mirror image of -1 is 0
+        i = i >= 2 * n ? i - 2 * n : i;  // period 2n
+        return i >= n ? 2 * n - 1 - i : i;
+    }
+    i = i < 0 ? 0 : i;
+    return i >= n ? n - 1 : i;
 }
 
+} // namespace texture_detail
+
+template <Wrap S, Wrap T>
 inline glm::vec4 Texture::bilinear_reduced(float u, float v, int level) const {
     const Level& L = levels_[level];
     // Texel centres at (i + 0.5) / size.
@@ -168,8 +184,10 @@ inline glm::vec4 Texture::bilinear_reduced(float u, float v, int level) const {
     const float fx = std::floor(x), fy = std::floor(y);
     const float tx = x - fx, ty = y - fy;
     const int x0 = int(fx), y0 = int(fy);
-    const int xa = wrap_index(x0, L.width, wrap_s_), xb = wrap_index(x0 + 1, L.width, wrap_s_);
-    const int ya = wrap_index(y0, L.height, wrap_t_), yb = wrap_index(y0 + 1, L.height, wrap_t_);
+    const int xa = texture_detail::wrap_index<S>(x0, L.width);
+    const int xb = texture_detail::wrap_index<S>(x0 + 1, L.width);
+    const int ya = texture_detail::wrap_index<T>(y0, L.height);
+    const int yb = texture_detail::wrap_index<T>(y0 + 1, L.height);
     const glm::vec4* base = texels_.data() + L.offset;
     const glm::vec4* row_a = base + std::size_t(ya) * std::size_t(L.width);
     const glm::vec4* row_b = base + std::size_t(yb) * std::size_t(L.width);
@@ -180,21 +198,32 @@ inline glm::vec4 Texture::bilinear_reduced(float u, float v, int level) const {
     return top + (bottom - top) * ty;
 }
 
-inline glm::vec4 Texture::sample_bilinear(float u, float v, int level) const {
-    return bilinear_reduced(reduce(u, wrap_s_), reduce(v, wrap_t_), clamp_level(level));
+template <Wrap S, Wrap T>
+inline glm::vec4 Texture::bilinear_wrapped(float u, float v, int level) const {
+    return bilinear_reduced<S, T>(texture_detail::reduce<S>(u), texture_detail::reduce<T>(v),
+                                  clamp_level(level));
 }
 
-inline glm::vec4 Texture::sample_trilinear(float u, float v, float lambda) const {
-    const float ur = reduce(u, wrap_s_), vr = reduce(v, wrap_t_);
-    if (!(lambda > 0.0f)) return bilinear_reduced(ur, vr, 0);  // magnification, or NaN
+template <Wrap S, Wrap T>
+inline glm::vec4 Texture::trilinear_wrapped(float u, float v, float lambda) const {
+    const float ur = texture_detail::reduce<S>(u), vr = texture_detail::reduce<T>(v);
+    if (!(lambda > 0.0f)) return bilinear_reduced<S, T>(ur, vr, 0);  // magnification, or NaN
     const int last = level_count_ - 1;
-    if (lambda >= float(last)) return bilinear_reduced(ur, vr, last);
+    if (lambda >= float(last)) return bilinear_reduced<S, T>(ur, vr, last);
     const float fl = std::floor(lambda);  // in [0, last): the int conversion is safe
     const int l0 = int(fl);
     const float t = lambda - fl;
-    const glm::vec4 a = bilinear_reduced(ur, vr, l0);
+    const glm::vec4 a = bilinear_reduced<S, T>(ur, vr, l0);
     if (t == 0.0f) return a;
-    return a + (bilinear_reduced(ur, vr, l0 + 1) - a) * t;
+    return a + (bilinear_reduced<S, T>(ur, vr, l0 + 1) - a) * t;
+}
+
+inline glm::vec4 Texture::sample_bilinear(float u, float v, int level) const {
+    return (this->*kBilinear[int(wrap_s_)][int(wrap_t_)])(u, v, level);
+}
+
+inline glm::vec4 Texture::sample_trilinear(float u, float v, float lambda) const {
+    return (this->*kTrilinear[int(wrap_s_)][int(wrap_t_)])(u, v, lambda);
 }
 
 inline float Texture::lod(float dudx, float dvdx, float dudy, float dvdy) const {

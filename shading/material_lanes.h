@@ -1,0 +1,227 @@
+// sample_material() for the lanes of a 4x4 block at once (all 16, or its live
+// lanes packed into 4 or 8): texture lookups through the block sampler
+// (sample_lanes.h), then the factors, clamps and normal mapping as loops over
+// lanes with selects instead of branches, which the compiler vectorises. Every
+// lane performs exactly the float operations of the scalar sample_material()
+// in the same order, so the two agree bit for bit (tests/test_sample_lanes.cpp)
+// and the stepper's scalar explanation of a pixel holds. The result feeds the
+// block lighting of light_block.h.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include "raster/limits.h"
+#include "shading/light_block.h"
+#include "shading/sample_lanes.h"
+#include "shading/surface.h"
+
+namespace prast {
+
+// The interpolated geometry of a block's lanes (SurfacePoint in structure-of-
+// arrays form). The uv derivatives belong to the 2x2 quads (fragment.h: x from
+// the quad's top row, y from its left column). With 16 lanes the block is
+// unpacked (lane l in quad l / 4); with 4 or 8, its live lanes are packed
+// first and quad[l] says which quad lane l came from.
+struct SurfaceLanes {
+    const float *Px, *Py, *Pz;      // world position
+    const float *Nx, *Ny, *Nz;      // interpolated vertex normal
+    const float *Tx, *Ty, *Tz, *Tw; // tangent + handedness
+    const float *u, *v;
+    const std::uint8_t* quad = nullptr;
+    float dudx[4], dvdx[4], dudy[4], dvdy[4];  // per quad
+    bool front_facing = true;
+};
+
+namespace material_lanes_detail {
+
+// safe_normalize(v, fallback) of surface.h, per lane.
+template <int N>
+[[gnu::always_inline]] inline void safe_normalize_lanes(float* __restrict x, float* __restrict y,
+                                                        float* __restrict z, const float* __restrict fx,
+                                                        const float* __restrict fy, const float* __restrict fz) {
+    for (int l = 0; l < N; ++l) {
+        const float len2 = x[l] * x[l] + y[l] * y[l] + z[l] * z[l];
+        const bool ok = (len2 > 1e-20f) & (len2 <= 3.402823466e38f);
+        const float s = std::sqrt(ok ? len2 : 1.0f);
+        x[l] = ok ? x[l] / s : fx[l];
+        y[l] = ok ? y[l] / s : fy[l];
+        z[l] = ok ? z[l] / s : fz[l];
+    }
+}
+
+template <int N>
+inline void copy_lanes(float* dst, const float* src) { std::memcpy(dst, src, sizeof(float) * N); }
+
+} // namespace material_lanes_detail
+
+// Fills the first N lanes of mb for the lanes in `live` (the others get
+// values nobody reads) and returns the live lanes an alpha MASK discards.
+template <int N = kBlockLanes>
+inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
+                                           MaterialBlock& mb) {
+    using namespace material_lanes_detail;
+    static_assert(N % 4 == 0 && N <= kBlockLanes, "whole vectors of lanes");
+    const Material& m = *bm.m;
+
+    // Look up every bound texture. Textures of one layout share their level
+    // of detail and texel indices (sample_lanes.h), prepared and read together.
+    enum { kBase, kMetalRough, kRough, kMetal, kNormal, kOcclusion, kEmissive, kMaps };
+    const Texture* maps[kMaps] = {bm.base_color, bm.metallic_roughness, bm.roughness, bm.metallic,
+                                  bm.normal, bm.occlusion, bm.emissive};
+    TexelLanes texel[kMaps];
+    if (maps[kBase] || maps[kMetalRough] || maps[kRough] || maps[kMetal] || maps[kNormal] || maps[kOcclusion] ||
+        maps[kEmissive]) {
+        std::uint32_t live_quads = 0;
+        if constexpr (N == kBlockLanes) {
+            for (int q = 0; q < 4; ++q) live_quads |= std::uint32_t(((live >> (4 * q)) & 0xFu) != 0) << q;
+        } else {
+            for (int l = 0; l < N; ++l)
+                if ((live >> l) & 1u) live_quads |= 1u << s.quad[l];
+        }
+        // Group the maps by layout, in order of first appearance.
+        int groups = 0;
+        const Texture* group_tex[kMaps][kMaps];
+        TexelLanes* group_out[kMaps][kMaps];
+        int group_size[kMaps];
+        for (int i = 0; i < kMaps; ++i) {
+            if (!maps[i]) continue;
+            int g = 0;
+            while (g < groups && !same_sampling_layout(*group_tex[g][0], *maps[i])) ++g;
+            if (g == groups) group_size[groups++] = 0;
+            group_tex[g][group_size[g]] = maps[i];
+            group_out[g][group_size[g]++] = &texel[i];
+        }
+        for (int g = 0; g < groups; ++g) {
+            // material_lods(): one lambda per quad with a live lane.
+            const Texture& first = *group_tex[g][0];
+            float lambda[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+            for (int q = 0; q < 4; ++q)
+                if ((live_quads >> q) & 1u) lambda[q] = first.lod(s.dudx[q], s.dvdx[q], s.dudy[q], s.dvdy[q]);
+            TrilinearLanes at;
+            prepare_trilinear_lanes<N>(first, s.u, s.v, lambda, s.quad, live, at);
+            fetch_trilinear_lanes<N>(group_tex[g], group_size[g], at, group_out[g]);
+        }
+    }
+
+    // Base colour and alpha: factor times the (already linear) texture.
+    const glm::vec4 bf = m.base_color_factor;
+    alignas(64) float alpha[N];
+    if (maps[kBase]) {
+        const TexelLanes& t = texel[kBase];
+        for (int l = 0; l < N; ++l) {
+            mb.ar[l] = bf.r * t.r[l]; mb.ag[l] = bf.g * t.g[l]; mb.ab[l] = bf.b * t.b[l];
+            alpha[l] = bf.a * t.a[l];
+        }
+    } else {
+        for (int l = 0; l < N; ++l) {
+            mb.ar[l] = bf.r; mb.ag[l] = bf.g; mb.ab[l] = bf.b;
+            alpha[l] = bf.a;
+        }
+    }
+    mb.ior = m.ior;
+
+    // Metal and roughness: glTF packs them in G and B; OBJ has separate maps (R).
+    alignas(64) float metallic[N], roughness[N];
+    for (int l = 0; l < N; ++l) {
+        metallic[l] = m.metallic_factor;
+        roughness[l] = m.roughness_factor;
+    }
+    if (maps[kMetalRough]) {
+        const TexelLanes& t = texel[kMetalRough];
+        for (int l = 0; l < N; ++l) {
+            roughness[l] *= t.g[l];
+            metallic[l] *= t.b[l];
+        }
+    }
+    if (maps[kRough])
+        for (int l = 0; l < N; ++l) roughness[l] *= texel[kRough].r[l];
+    if (maps[kMetal])
+        for (int l = 0; l < N; ++l) metallic[l] *= texel[kMetal].r[l];
+    for (int l = 0; l < N; ++l) {
+        // glm::clamp(x, 0, 1) = min(max(x, 0), 1), NaN passing through.
+        const float mt = metallic[l] < 0.0f ? 0.0f : metallic[l];
+        const float rg = roughness[l] < 0.0f ? 0.0f : roughness[l];
+        mb.metallic[l] = 1.0f < mt ? 1.0f : mt;
+        mb.roughness[l] = 1.0f < rg ? 1.0f : rg;
+    }
+
+    if (maps[kOcclusion]) {
+        const float strength = m.occlusion_strength;
+        for (int l = 0; l < N; ++l) mb.occlusion[l] = 1.0f + strength * (texel[kOcclusion].r[l] - 1.0f);
+    } else {
+        for (int l = 0; l < N; ++l) mb.occlusion[l] = 1.0f;
+    }
+    const glm::vec3 ef = m.emissive_factor;
+    if (maps[kEmissive]) {
+        const TexelLanes& t = texel[kEmissive];
+        for (int l = 0; l < N; ++l) {
+            mb.er[l] = ef.r * t.r[l]; mb.eg[l] = ef.g * t.g[l]; mb.eb[l] = ef.b * t.b[l];
+        }
+    } else {
+        for (int l = 0; l < N; ++l) {
+            mb.er[l] = ef.r; mb.eg[l] = ef.g; mb.eb[l] = ef.b;
+        }
+    }
+
+    // Geometric frame; a back face of a double-sided material flips all of it.
+    alignas(64) float Nx[N], Ny[N], Nz[N], zero[N], one[N];
+    copy_lanes<N>(Nx, s.Nx); copy_lanes<N>(Ny, s.Ny); copy_lanes<N>(Nz, s.Nz);
+    for (int l = 0; l < N; ++l) {
+        zero[l] = 0.0f;
+        one[l] = 1.0f;
+    }
+    safe_normalize_lanes<N>(Nx, Ny, Nz, zero, zero, one);
+    const float flip = s.front_facing ? 1.0f : -1.0f;
+    for (int l = 0; l < N; ++l) {
+        mb.Nx[l] = Nx[l] * flip; mb.Ny[l] = Ny[l] * flip; mb.Nz[l] = Nz[l] * flip;
+    }
+    if (maps[kNormal]) {
+        // Tangent space, OpenGL convention: red along T (+u), green along
+        // B = cross(N, T) * w (up the image). T is re-orthogonalised per pixel.
+        alignas(64) float Tx[N], Ty[N], Tz[N], ntx[N], nty[N], ntz[N], nx[N], ny[N], nz[N];
+        const TexelLanes& tex = texel[kNormal];
+        const float scale = m.normal_scale;
+        for (int l = 0; l < N; ++l) {
+            const float d = Nx[l] * s.Tx[l] + Ny[l] * s.Ty[l] + Nz[l] * s.Tz[l];
+            Tx[l] = s.Tx[l] - Nx[l] * d;
+            Ty[l] = s.Ty[l] - Ny[l] * d;
+            Tz[l] = s.Tz[l] - Nz[l] * d;
+            ntx[l] = (tex.r[l] * 2.0f - 1.0f) * scale;
+            nty[l] = (tex.g[l] * 2.0f - 1.0f) * scale;
+            ntz[l] = tex.b[l] * 2.0f - 1.0f;
+        }
+        safe_normalize_lanes<N>(Tx, Ty, Tz, zero, zero, zero);
+        safe_normalize_lanes<N>(ntx, nty, ntz, zero, zero, one);
+        alignas(64) float mapped[N];  // 1 where the tangent frame exists
+        for (int l = 0; l < N; ++l) {
+            mapped[l] = Tx[l] * Tx[l] + Ty[l] * Ty[l] + Tz[l] * Tz[l] > 0.0f ? 1.0f : 0.0f;
+            const float w = s.Tw[l] < 0.0f ? -1.0f : 1.0f;
+            const float Bx = (Ny[l] * Tz[l] - Ty[l] * Nz[l]) * w;
+            const float By = (Nz[l] * Tx[l] - Tz[l] * Nx[l]) * w;
+            const float Bz = (Nx[l] * Ty[l] - Tx[l] * Ny[l]) * w;
+            nx[l] = Tx[l] * ntx[l] + Bx * nty[l] + Nx[l] * ntz[l];
+            ny[l] = Ty[l] * ntx[l] + By * nty[l] + Ny[l] * ntz[l];
+            nz[l] = Tz[l] * ntx[l] + Bz * nty[l] + Nz[l] * ntz[l];
+        }
+        safe_normalize_lanes<N>(nx, ny, nz, Nx, Ny, Nz);
+        for (int l = 0; l < N; ++l) {
+            const bool use = mapped[l] != 0.0f;
+            mb.Nx[l] = use ? nx[l] * flip : mb.Nx[l];
+            mb.Ny[l] = use ? ny[l] * flip : mb.Ny[l];
+            mb.Nz[l] = use ? nz[l] * flip : mb.Nz[l];
+        }
+    }
+
+    copy_lanes<N>(mb.Px, s.Px); copy_lanes<N>(mb.Py, s.Py); copy_lanes<N>(mb.Pz, s.Pz);
+
+    // Alpha MASK: discard below the cutoff (NaN alpha too).
+    std::uint32_t kill = 0;
+    if (m.alpha_mode == AlphaMode::Mask) {
+        const float cutoff = m.alpha_cutoff;
+        for (int l = 0; l < N; ++l) kill |= std::uint32_t(!(alpha[l] >= cutoff)) << l;
+    }
+    return kill & live;
+}
+
+} // namespace prast

@@ -1,0 +1,278 @@
+// Trilinear texture sampling for the 16 lanes of a 4x4 block at once, in two
+// steps: prepare_trilinear_lanes() turns the lanes' uv and their quads' lambda
+// into texel indices and filter weights (branch-free loops over lanes, which
+// the compiler vectorises), and fetch_trilinear_lanes() reads and blends the
+// texels of the live lanes only (one 4-channel vector per texel). Every lane
+// performs exactly the float operations of Texture::sample_trilinear() in the
+// same order, so the two agree bit for bit (tests/test_sample_lanes.cpp); the
+// stepper and the debug views keep using the scalar sampler.
+//
+// The indices depend only on the level-0 size and the wrap modes, as does
+// lambda (Texture::lod), so textures with the same layout share one
+// preparation: a material whose maps have one size prepares once per block.
+// The loops run over the first N lanes (4, 8 or 16): the fragment program
+// packs the live lanes of a sparse block first, each lane remembering the
+// 2x2 quad whose lambda it uses.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include <glm/glm.hpp>
+
+#include "raster/limits.h"
+#include "shading/texture.h"
+
+namespace prast {
+
+// Per-lane sampling result, structure of arrays.
+struct TexelLanes {
+    static constexpr int N = kBlockLanes;
+    alignas(64) float r[N], g[N], b[N], a[N];
+};
+
+// Where the lanes of one block sample a texture layout. Level A is the level
+// sample_trilinear() reads first (the only one when magnifying, at the last
+// level, or at an integer lambda); the lanes in `blend` also read level B and
+// return a + (b - a) t with t = lambda - floor(lambda).
+struct TrilinearLanes {
+    static constexpr int N = kBlockLanes;
+    // Texel indices into Texture::texel_data(): (x0, y0), (x1, y0), (x0, y1), (x1, y1).
+    // Texel counts stay below 2^31 (kMaxImageTexels = 2^28 for level 0).
+    alignas(64) std::int32_t ia[4][N], ib[4][N];
+    alignas(64) float txa[N], tya[N], txb[N], tyb[N], t[N];
+    std::uint32_t live = 0;     // lanes to fetch
+    std::uint32_t blend = 0;    // lanes that blend two levels
+};
+
+// True when a and b sample at the same texel indices with the same weights
+// for any uv and derivatives: same level-0 size (hence the same chain and the
+// same lambda) and the same wrap modes.
+inline bool same_sampling_layout(const Texture& a, const Texture& b) {
+    return a.width(0) == b.width(0) && a.height(0) == b.height(0) && a.wrap_s() == b.wrap_s() &&
+           a.wrap_t() == b.wrap_t();
+}
+
+namespace sample_lanes_detail {
+
+constexpr int kMaxN = kBlockLanes;
+
+// One mip level per lane (its quad's).
+struct LevelLanes {
+    alignas(64) float fw[kMaxN], fh[kMaxN];
+    alignas(64) std::int32_t w[kMaxN], h[kMaxN], offset[kMaxN];
+
+    // Lanes [begin, end) read `level`.
+    void set(const Texture& tex, int level, int begin, int end) {
+        const std::int32_t lw = tex.width(level), lh = tex.height(level);
+        const std::int32_t loff = std::int32_t(tex.level_offset(level));
+        const float lfw = float(lw), lfh = float(lh);
+        for (int l = begin; l < end; ++l) {
+            fw[l] = lfw; fh[l] = lfh;
+            w[l] = lw; h[l] = lh; offset[l] = loff;
+        }
+    }
+};
+
+// Texture::bilinear_reduced() up to the texel indices, for the first N lanes.
+template <int N, Wrap S, Wrap T>
+inline void bilinear_indices(const float* __restrict ur, const float* __restrict vr,
+                             const LevelLanes& __restrict L, std::int32_t (*__restrict idx)[kMaxN],
+                             float* __restrict tx, float* __restrict ty) {
+    using texture_detail::wrap_index;
+    for (int l = 0; l < N; ++l) {
+        const float x = ur[l] * L.fw[l] - 0.5f, y = vr[l] * L.fh[l] - 0.5f;
+        const float fx = std::floor(x), fy = std::floor(y);
+        tx[l] = x - fx;
+        ty[l] = y - fy;
+        const int x0 = int(fx), y0 = int(fy), w = L.w[l], h = L.h[l];
+        const int xa = wrap_index<S>(x0, w), xb = wrap_index<S>(x0 + 1, w);
+        const int row_a = L.offset[l] + wrap_index<T>(y0, h) * w;
+        const int row_b = L.offset[l] + wrap_index<T>(y0 + 1, h) * w;
+        idx[0][l] = row_a + xa;
+        idx[1][l] = row_a + xb;
+        idx[2][l] = row_b + xa;
+        idx[3][l] = row_b + xb;
+    }
+}
+
+template <int N, Wrap S, Wrap T>
+inline void prepare(const float* __restrict u, const float* __restrict v, const LevelLanes& A,
+                    const LevelLanes* B, TrilinearLanes& out) {
+    alignas(64) float ur[kMaxN], vr[kMaxN];
+    for (int l = 0; l < N; ++l) {
+        ur[l] = texture_detail::reduce<S>(u[l]);
+        vr[l] = texture_detail::reduce<T>(v[l]);
+    }
+    bilinear_indices<N, S, T>(ur, vr, A, out.ia, out.txa, out.tya);
+    if (B) bilinear_indices<N, S, T>(ur, vr, *B, out.ib, out.txb, out.tyb);
+}
+
+template <int N, Wrap S>
+inline void prepare_s(Wrap t, const float* u, const float* v, const LevelLanes& A, const LevelLanes* B,
+                      TrilinearLanes& out) {
+    switch (t) {
+    case Wrap::Repeat: prepare<N, S, Wrap::Repeat>(u, v, A, B, out); return;
+    case Wrap::ClampToEdge: prepare<N, S, Wrap::ClampToEdge>(u, v, A, B, out); return;
+    case Wrap::MirroredRepeat: prepare<N, S, Wrap::MirroredRepeat>(u, v, A, B, out); return;
+    }
+}
+
+// 4-channel float vector (one texel); lane-wise IEEE operations, no contraction.
+typedef float Float4 __attribute__((vector_size(16)));
+
+inline Float4 load_texel(const glm::vec4* texels, std::int32_t i) {
+    Float4 r;
+    std::memcpy(&r, &texels[i], sizeof r);
+    return r;
+}
+
+inline Float4 bilinear(const glm::vec4* texels, const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty,
+                       int l) {
+    const Float4 a = load_texel(texels, idx[0][l]), b = load_texel(texels, idx[1][l]);
+    const Float4 c = load_texel(texels, idx[2][l]), d = load_texel(texels, idx[3][l]);
+    const Float4 top = a + (b - a) * tx[l];
+    const Float4 bottom = c + (d - c) * tx[l];
+    return top + (bottom - top) * ty[l];
+}
+
+} // namespace sample_lanes_detail
+
+// Prepares the first N lanes: u and v hold their coordinates, lambda[q] the
+// level of detail of quad q (Texture::lod of its uv derivatives), quad[l] the
+// quad of lane l when N < 16 (the lanes of a sparse block packed first); with
+// N = 16 the block is unpacked and lane l lies in quad l / 4. Only the lanes in
+// `live` are fetched later, but every lane gets valid indices (reduce() folds
+// any coordinate).
+template <int N = kBlockLanes>
+inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const float* v, const float lambda[4],
+                                    const std::uint8_t* quad, std::uint32_t live, TrilinearLanes& out) {
+    using namespace sample_lanes_detail;
+    static_assert(N % 4 == 0 && N <= kMaxN, "whole vectors of lanes");
+    constexpr bool unpacked = N == kMaxN;
+    auto quad_of = [quad](int l) { return unpacked ? l >> 2 : int(quad[l]); };
+
+    // The level choice of Texture::trilinear_wrapped(), once per quad with a
+    // live lane: level A alone, or A and B = A + 1 blended by t.
+    std::uint32_t live_quads = 0;
+    if constexpr (unpacked) {
+        for (int q = 0; q < 4; ++q) live_quads |= std::uint32_t(((live >> (4 * q)) & 0xFu) != 0) << q;
+    } else {
+        for (int l = 0; l < N; ++l)
+            if ((live >> l) & 1u) live_quads |= 1u << quad_of(l);
+    }
+    int la[4] = {0, 0, 0, 0};
+    float t[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    std::uint32_t blend_quads = 0;
+    const int last = tex.levels() - 1;
+    for (int q = 0; q < 4; ++q) {
+        if (!((live_quads >> q) & 1u)) continue;
+        const float lam = lambda[q];
+        if (!(lam > 0.0f)) {
+            la[q] = 0;  // magnification, or NaN
+        } else if (lam >= float(last)) {
+            la[q] = last;
+        } else {
+            const float fl = std::floor(lam);
+            la[q] = int(fl);
+            t[q] = lam - fl;
+            if (t[q] != 0.0f) blend_quads |= 1u << q;
+        }
+    }
+    out.live = live;
+    out.blend = 0;
+    if constexpr (unpacked) {
+        for (int q = 0; q < 4; ++q) {
+            for (int l = 4 * q; l < 4 * q + 4; ++l) out.t[l] = t[q];
+            out.blend |= ((blend_quads >> q) & 1u) * (0xFu << (4 * q));
+        }
+    } else {
+        for (int l = 0; l < N; ++l) {
+            out.t[l] = t[quad_of(l)];
+            out.blend |= ((blend_quads >> quad_of(l)) & 1u) << l;
+        }
+    }
+    out.blend &= live;
+
+    // Per-lane level sizes; usually all quads read the same levels.
+    bool uniform = true;
+    const int q0 = live_quads ? __builtin_ctz(live_quads) : 0;
+    for (int q = q0 + 1; q < 4; ++q)
+        if ((live_quads >> q) & 1u)
+            uniform &= la[q] == la[q0] && ((blend_quads >> q) & 1u) == ((blend_quads >> q0) & 1u);
+    LevelLanes A, B;
+    if (uniform) {
+        A.set(tex, la[q0], 0, N);
+    } else if (unpacked) {
+        for (int q = 0; q < 4; ++q) A.set(tex, la[q], 4 * q, 4 * q + 4);
+    } else {
+        for (int l = 0; l < N; ++l) A.set(tex, la[quad_of(l)], l, l + 1);
+    }
+    const LevelLanes* b = nullptr;
+    if (out.blend) {
+        // Lanes that do not blend get level A again (never read).
+        if (uniform) {
+            B.set(tex, la[q0] + 1, 0, N);
+        } else if (unpacked) {
+            for (int q = 0; q < 4; ++q) B.set(tex, la[q] + ((blend_quads >> q) & 1u), 4 * q, 4 * q + 4);
+        } else {
+            for (int l = 0; l < N; ++l) B.set(tex, la[quad_of(l)] + ((blend_quads >> quad_of(l)) & 1u), l, l + 1);
+        }
+        b = &B;
+    }
+    switch (tex.wrap_s()) {
+    case Wrap::Repeat: prepare_s<N, Wrap::Repeat>(tex.wrap_t(), u, v, A, b, out); return;
+    case Wrap::ClampToEdge: prepare_s<N, Wrap::ClampToEdge>(tex.wrap_t(), u, v, A, b, out); return;
+    case Wrap::MirroredRepeat: prepare_s<N, Wrap::MirroredRepeat>(tex.wrap_t(), u, v, A, b, out); return;
+    }
+}
+
+// Filters the live lanes of `at` from the K textures tex[k] (all of the layout
+// the lanes were prepared for) into out[k]; the other lanes of the first N
+// are set to 0. One pass over the lanes for all K: the indices and weights are
+// read once and the texel loads of the textures overlap.
+template <int N, int K>
+inline void fetch_trilinear_lanes(const Texture* const* tex, const TrilinearLanes& at, TexelLanes* const* out) {
+    using namespace sample_lanes_detail;
+    if (at.live != (1u << N) - 1u) {
+        for (int k = 0; k < K; ++k)
+            for (int l = 0; l < N; ++l) out[k]->r[l] = out[k]->g[l] = out[k]->b[l] = out[k]->a[l] = 0.0f;
+    }
+    const glm::vec4* texels[K];
+    for (int k = 0; k < K; ++k) texels[k] = tex[k]->texel_data();
+    for (std::uint32_t m = at.live; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        Float4 c[K];
+        for (int k = 0; k < K; ++k) c[k] = bilinear(texels[k], at.ia, at.txa, at.tya, l);
+        if ((at.blend >> l) & 1u) {
+            for (int k = 0; k < K; ++k) {
+                const Float4 cb = bilinear(texels[k], at.ib, at.txb, at.tyb, l);
+                c[k] = c[k] + (cb - c[k]) * at.t[l];
+            }
+        }
+        for (int k = 0; k < K; ++k) {
+            out[k]->r[l] = c[k][0];
+            out[k]->g[l] = c[k][1];
+            out[k]->b[l] = c[k][2];
+            out[k]->a[l] = c[k][3];
+        }
+    }
+}
+
+// Any number of textures, up to three per pass.
+template <int N = kBlockLanes>
+inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const TrilinearLanes& at,
+                                  TexelLanes* const* out) {
+    for (; count >= 3; count -= 3, tex += 3, out += 3) fetch_trilinear_lanes<N, 3>(tex, at, out);
+    if (count == 2) fetch_trilinear_lanes<N, 2>(tex, at, out);
+    if (count == 1) fetch_trilinear_lanes<N, 1>(tex, at, out);
+}
+
+template <int N = kBlockLanes>
+inline void fetch_trilinear_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+    const Texture* t = &tex;
+    TexelLanes* o = &out;
+    fetch_trilinear_lanes<N, 1>(&t, at, &o);
+}
+
+} // namespace prast

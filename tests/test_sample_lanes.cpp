@@ -1,0 +1,355 @@
+// The 4x4-block texture sampler (sample_lanes.h) and material sampling
+// (material_lanes.h) against the scalar Texture::sample_trilinear() and
+// sample_material(): they must agree bit for bit, for every wrap mode, level
+// count, level of detail and coordinate (NaN and infinities included), with
+// the block unpacked (16 lanes) or its live lanes packed into 4 or 8. Then the
+// whole lit path of PbrProgram::fragment() against the scalar functions.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "raster/fragment.h"
+#include "shading/material_lanes.h"
+#include "shading/pbr_program.h"
+#include "shading/sample_lanes.h"
+
+using namespace prast;
+
+namespace {
+
+std::uint32_t bits(float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return u;
+}
+
+Texture random_texture(std::mt19937& rng, int w, int h, Wrap s, Wrap t) {
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    Image img;
+    img.width = w;
+    img.height = h;
+    img.rgba.resize(std::size_t(w) * h * 4);
+    for (float& c : img.rgba) c = uni(rng);
+    return Texture::from_image(std::move(img), s, t);
+}
+
+// A coordinate: mostly ordinary, sometimes on a texel centre or edge, far
+// away, or not a number at all.
+float random_coord(std::mt19937& rng, int size) {
+    std::uniform_real_distribution<float> uni(-3.0f, 3.0f);
+    std::uniform_int_distribution<int> pick(0, 19), texel(-2 * size, 2 * size);
+    switch (pick(rng)) {
+    case 0: return std::numeric_limits<float>::quiet_NaN();
+    case 1: return std::numeric_limits<float>::infinity();
+    case 2: return -std::numeric_limits<float>::infinity();
+    case 3: return 1e30f * uni(rng);
+    case 4: return float(texel(rng)) / float(size);                  // texel edge
+    case 5: return (float(texel(rng)) + 0.5f) / float(size);         // texel centre
+    case 6: return float(texel(rng) / size);                         // integer
+    default: return uni(rng);
+    }
+}
+
+float random_lambda(std::mt19937& rng, int levels) {
+    std::uniform_real_distribution<float> uni(-2.0f, float(levels) + 1.0f);
+    std::uniform_int_distribution<int> pick(0, 9), level(-1, levels + 1);
+    switch (pick(rng)) {
+    case 0: return std::numeric_limits<float>::quiet_NaN();
+    case 1: return float(level(rng));  // integer lambda: one level
+    case 2: return 0.0f;
+    case 3: return -64.0f;
+    case 4: return 64.0f;
+    default: return uni(rng);
+    }
+}
+
+// Picks N lanes of a 16-lane block: unpacked (N = 16) or the live lanes of a
+// random mask packed first, the spare lanes repeating the first.
+template <int N>
+struct Packing {
+    std::uint8_t lane[N], quad[N];
+    std::uint32_t block_live = 0, live = 0;
+
+    explicit Packing(std::mt19937& rng) {
+        std::uniform_int_distribution<std::uint32_t> mask(1, 0xFFFFu);
+        if (N == kBlockLanes) {
+            block_live = live = mask(rng);
+            for (int l = 0; l < N; ++l) lane[l] = std::uint8_t(l);
+        } else {
+            do block_live = mask(rng);
+            while (__builtin_popcount(block_live) > N);
+            int n = 0;
+            for (std::uint32_t m = block_live; m; m &= m - 1) lane[n++] = std::uint8_t(__builtin_ctz(m));
+            live = (1u << n) - 1u;
+            for (int l = n; l < N; ++l) lane[l] = lane[0];
+        }
+        for (int l = 0; l < N; ++l) quad[l] = std::uint8_t(lane[l] >> 2);
+    }
+};
+
+template <int N>
+void check_sampler(std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    const Wrap wraps[3] = {Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat};
+    std::uniform_int_distribution<int> size_pick(0, 7), wrap_pick(0, 2);
+    const int sizes[8] = {1, 2, 3, 5, 8, 17, 32, 64};
+    const int w = sizes[size_pick(rng)], h = sizes[size_pick(rng)];
+    const Texture tex = random_texture(rng, w, h, wraps[wrap_pick(rng)], wraps[wrap_pick(rng)]);
+
+    Packing<N> pk(rng);
+    alignas(64) float u[kBlockLanes], v[kBlockLanes], block_u[kBlockLanes], block_v[kBlockLanes];
+    for (int l = 0; l < kBlockLanes; ++l) {
+        block_u[l] = random_coord(rng, w);
+        block_v[l] = random_coord(rng, h);
+    }
+    for (int l = 0; l < N; ++l) {
+        u[l] = block_u[pk.lane[l]];
+        v[l] = block_v[pk.lane[l]];
+    }
+    float lambda[4];
+    for (float& x : lambda) x = random_lambda(rng, tex.levels());
+
+    TrilinearLanes at;
+    prepare_trilinear_lanes<N>(tex, u, v, lambda, pk.quad, pk.live, at);
+    TexelLanes out;
+    fetch_trilinear_lanes<N>(tex, at, out);
+    for (int l = 0; l < N; ++l) {
+        if (!((pk.live >> l) & 1u)) continue;
+        const glm::vec4 ref = tex.sample_trilinear(u[l], v[l], lambda[pk.quad[l]]);
+        INFO("seed ", seed, " N ", N, " lane ", l, " size ", w, "x", h, " uv ", u[l], ",", v[l],
+             " lambda ", lambda[pk.quad[l]]);
+        CHECK(bits(out.r[l]) == bits(ref.r));
+        CHECK(bits(out.g[l]) == bits(ref.g));
+        CHECK(bits(out.b[l]) == bits(ref.b));
+        CHECK(bits(out.a[l]) == bits(ref.a));
+    }
+}
+
+template <int N>
+void check_material(std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f), sym(-1.0f, 1.0f);
+    std::uniform_int_distribution<int> coin(0, 1), pick(0, 9);
+    const Wrap wraps[3] = {Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat};
+    std::uniform_int_distribution<int> wrap_pick(0, 2);
+
+    // Maps of two layouts, so that some share a preparation and some do not.
+    const Wrap ws = wraps[wrap_pick(rng)], wt = wraps[wrap_pick(rng)];
+    std::vector<Texture> textures;
+    for (int i = 0; i < 7; ++i)
+        textures.push_back(coin(rng) ? random_texture(rng, 16, 16, ws, wt)
+                                     : random_texture(rng, 8, 32, wraps[wrap_pick(rng)], Wrap::Repeat));
+    Material m;
+    m.base_color_factor = {uni(rng), uni(rng), uni(rng), uni(rng)};
+    m.metallic_factor = 1.5f * uni(rng) - 0.2f;  // the clamps to [0, 1] matter
+    m.roughness_factor = 1.5f * uni(rng) - 0.2f;
+    m.emissive_factor = {uni(rng), uni(rng), uni(rng)};
+    m.normal_scale = 2.0f * sym(rng);
+    m.occlusion_strength = uni(rng);
+    m.ior = 1.2f + uni(rng);
+    m.alpha_mode = coin(rng) ? AlphaMode::Mask : AlphaMode::Opaque;
+    m.alpha_cutoff = uni(rng);
+    BoundMaterial bm;
+    bm.m = &m;
+    const Texture** slots[7] = {&bm.base_color, &bm.metallic_roughness, &bm.roughness, &bm.metallic,
+                                &bm.normal, &bm.occlusion, &bm.emissive};
+    for (int i = 0; i < 7; ++i)
+        if (coin(rng)) *slots[i] = &textures[std::size_t(i)];
+
+    // A block of surface points; a few lanes with degenerate normals or
+    // tangents exercise the fallbacks.
+    Packing<N> pk(rng);
+    const bool front = coin(rng);
+    alignas(64) float var[12][kBlockLanes];
+    const float du = 0.05f * sym(rng), dv = 0.05f * sym(rng);
+    const float u0 = 2.0f * sym(rng), v0 = 2.0f * sym(rng);
+    for (int l = 0; l < kBlockLanes; ++l) {
+        for (int k = 0; k < 3; ++k) var[k][l] = 3.0f * sym(rng);
+        for (int k = 3; k < 6; ++k) var[k][l] = sym(rng);
+        var[6][l] = u0 + du * float(lane_x(l)) + 0.01f * sym(rng);
+        var[7][l] = v0 + dv * float(lane_y(l)) + 0.01f * sym(rng);
+        for (int k = 8; k < 11; ++k) var[k][l] = sym(rng);
+        var[11][l] = coin(rng) ? 1.0f : -1.0f;
+        switch (pick(rng)) {
+        case 0: var[3][l] = var[4][l] = var[5][l] = 0.0f; break;      // no normal
+        case 1: for (int k = 0; k < 3; ++k) var[8 + k][l] = var[3 + k][l]; break;  // T parallel to N
+        case 2: var[8][l] = var[9][l] = var[10][l] = 0.0f; break;     // no tangent
+        default: break;
+        }
+    }
+    alignas(64) float packed[12][kBlockLanes];
+    for (int k = 0; k < 12; ++k)
+        for (int l = 0; l < N; ++l) packed[k][l] = var[k][pk.lane[l]];
+    SurfaceLanes s;
+    s.Px = packed[0]; s.Py = packed[1]; s.Pz = packed[2];
+    s.Nx = packed[3]; s.Ny = packed[4]; s.Nz = packed[5];
+    s.u = packed[6]; s.v = packed[7];
+    s.Tx = packed[8]; s.Ty = packed[9]; s.Tz = packed[10]; s.Tw = packed[11];
+    s.quad = pk.quad;
+    for (int q = 0; q < 4; ++q) {
+        const int l = 4 * q;
+        s.dudx[q] = var[6][l + 1] - var[6][l]; s.dvdx[q] = var[7][l + 1] - var[7][l];
+        s.dudy[q] = var[6][l + 2] - var[6][l]; s.dvdy[q] = var[7][l + 2] - var[7][l];
+    }
+    s.front_facing = front;
+
+    MaterialBlock mb;
+    const std::uint32_t kill = sample_material_lanes<N>(bm, s, pk.live, mb);
+    for (int l = 0; l < N; ++l) {
+        if (!((pk.live >> l) & 1u)) continue;
+        const int bl = pk.lane[l], q = bl & ~3;
+        SurfacePoint sp;
+        sp.P = {var[0][bl], var[1][bl], var[2][bl]};
+        sp.N = {var[3][bl], var[4][bl], var[5][bl]};
+        sp.uv = {var[6][bl], var[7][bl]};
+        sp.T = {var[8][bl], var[9][bl], var[10][bl], var[11][bl]};
+        sp.duv_dx = {var[6][q + 1] - var[6][q], var[7][q + 1] - var[7][q]};
+        sp.duv_dy = {var[6][q + 2] - var[6][q], var[7][q + 2] - var[7][q]};
+        sp.front_facing = front;
+        const MaterialSample ms = sample_material(bm, sp);
+        INFO("seed ", seed, " N ", N, " lane ", l, " (block lane ", bl, ")");
+        const bool killed = m.alpha_mode == AlphaMode::Mask && !(ms.alpha >= m.alpha_cutoff);
+        CHECK(((kill >> l) & 1u) == (killed ? 1u : 0u));
+        CHECK(bits(mb.ar[l]) == bits(ms.albedo.r));
+        CHECK(bits(mb.ag[l]) == bits(ms.albedo.g));
+        CHECK(bits(mb.ab[l]) == bits(ms.albedo.b));
+        CHECK(bits(mb.metallic[l]) == bits(ms.metallic));
+        CHECK(bits(mb.roughness[l]) == bits(ms.roughness));
+        CHECK(bits(mb.occlusion[l]) == bits(ms.occlusion));
+        CHECK(bits(mb.er[l]) == bits(ms.emissive.r));
+        CHECK(bits(mb.eg[l]) == bits(ms.emissive.g));
+        CHECK(bits(mb.eb[l]) == bits(ms.emissive.b));
+        CHECK(bits(mb.Nx[l]) == bits(ms.N.x));
+        CHECK(bits(mb.Ny[l]) == bits(ms.N.y));
+        CHECK(bits(mb.Nz[l]) == bits(ms.N.z));
+        CHECK(bits(mb.Px[l]) == bits(sp.P.x));
+        CHECK(bits(mb.ior) == bits(ms.ior));
+    }
+}
+
+// PbrProgram::fragment() on a block with a random coverage mask (so that it
+// takes the 4-, 8- or 16-lane path) against sample_material() and
+// shade_surface() lane by lane.
+void check_program(std::uint32_t seed, BrdfModel model) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f), sym(-1.0f, 1.0f);
+    std::uniform_int_distribution<int> coin(0, 1), count(1, 16);
+    const Texture albedo = random_texture(rng, 32, 32, Wrap::Repeat, Wrap::Repeat);
+    const Texture normal = random_texture(rng, 32, 32, Wrap::Repeat, Wrap::Repeat);
+    const Texture orm = random_texture(rng, 16, 64, Wrap::MirroredRepeat, Wrap::ClampToEdge);
+    Material m;
+    m.base_color_factor = {uni(rng), uni(rng), uni(rng), uni(rng)};
+    m.metallic_factor = uni(rng);
+    m.roughness_factor = uni(rng);
+    m.alpha_mode = coin(rng) ? AlphaMode::Mask : AlphaMode::Opaque;
+    m.alpha_cutoff = 0.3f * uni(rng);
+    BoundMaterial bm;
+    bm.m = &m;
+    if (coin(rng)) {
+        bm.base_color = &albedo;
+        bm.normal = &normal;
+        bm.metallic_roughness = &orm;
+    }
+    ShadingContext ctx;
+    ctx.eye = {sym(rng), 2.0f, 5.0f};
+    ctx.model = model;
+    ShadingLight sun, lamp;
+    sun.direction = glm::normalize(glm::vec3(sym(rng), 1.0f, sym(rng)));
+    sun.radiance = {3.0f, 2.5f, 2.0f};
+    lamp.point = true;
+    lamp.position = {1.0f, 2.0f, 3.0f};
+    lamp.radiance = {10.0f, 12.0f, 14.0f};
+    ctx.lights = {sun, lamp};
+
+    PbrProgram prog;
+    prog.material = &bm;
+    prog.ctx = &ctx;
+    FragmentBlock<kPbrVaryings> in;
+    for (int l = 0; l < kBlockLanes; ++l) {
+        for (int k = 0; k < kPbrVaryings; ++k) in.var[k][l] = sym(rng);
+        in.var[kVarUV][l] = 0.3f + 0.02f * float(lane_x(l)) + 0.001f * sym(rng);
+        in.var[kVarUV + 1][l] = 0.6f + 0.03f * float(lane_y(l)) + 0.001f * sym(rng);
+        in.z[l] = uni(rng);
+    }
+    // Live lanes: a random count at random places.
+    std::vector<int> order(kBlockLanes);
+    for (int l = 0; l < kBlockLanes; ++l) order[std::size_t(l)] = l;
+    std::shuffle(order.begin(), order.end(), rng);
+    const int n = count(rng);
+    for (int i = 0; i < n; ++i) in.mask |= 1u << order[std::size_t(i)];
+    in.front_facing = coin(rng);
+
+    FragmentOut out;
+    prog.fragment(in, out);
+    MaterialLods lods;
+    for (int l = 0; l < kBlockLanes; ++l) {
+        if (!((in.mask >> l) & 1u)) continue;
+        const SurfacePoint sp = PbrProgram::surface_point(in, l);
+        lods = material_lods(bm, sp.duv_dx, sp.duv_dy);
+        const MaterialSample ms = sample_material(bm, sp, lods);
+        INFO("seed ", seed, " live ", n, " lane ", l);
+        const bool killed = m.alpha_mode == AlphaMode::Mask && !(ms.alpha >= m.alpha_cutoff);
+        CHECK(((out.kill >> l) & 1u) == (killed ? 1u : 0u));
+        if (killed) continue;
+        const glm::vec3 ref = shade_surface(ms, sp, ctx);
+        CHECK(bits(out.r[l]) == bits(ref.r));
+        CHECK(bits(out.g[l]) == bits(ref.g));
+        CHECK(bits(out.b[l]) == bits(ref.b));
+        CHECK(out.a[l] == 1.0f);
+    }
+    CHECK((out.kill & ~in.mask) == 0u);
+}
+
+} // namespace
+
+TEST_SUITE("sample_lanes") {
+TEST_CASE("block trilinear sampling equals Texture::sample_trilinear bit for bit") {
+    for (std::uint32_t seed = 1; seed <= 3000; ++seed) {
+        check_sampler<16>(seed);
+        check_sampler<8>(seed);
+        check_sampler<4>(seed);
+    }
+}
+
+TEST_CASE("a 512x512 texture: every level, uniform and mixed levels across quads") {
+    std::mt19937 rng(7);
+    const Texture tex = random_texture(rng, 512, 512, Wrap::Repeat, Wrap::MirroredRepeat);
+    std::uniform_real_distribution<float> uni(-2.0f, 2.0f), lam(0.0f, 10.0f);
+    for (int iter = 0; iter < 500; ++iter) {
+        alignas(64) float u[kBlockLanes], v[kBlockLanes];
+        for (int l = 0; l < kBlockLanes; ++l) { u[l] = uni(rng); v[l] = uni(rng); }
+        float lambda[4];
+        const float shared = lam(rng);
+        for (float& x : lambda) x = iter % 2 ? shared : lam(rng);
+        TrilinearLanes at;
+        prepare_trilinear_lanes<16>(tex, u, v, lambda, nullptr, 0xFFFFu, at);
+        TexelLanes out;
+        fetch_trilinear_lanes<16>(tex, at, out);
+        for (int l = 0; l < kBlockLanes; ++l) {
+            const glm::vec4 ref = tex.sample_trilinear(u[l], v[l], lambda[l / 4]);
+            CHECK(bits(out.r[l]) == bits(ref.r));
+            CHECK(bits(out.a[l]) == bits(ref.a));
+        }
+    }
+}
+
+TEST_CASE("the lit fragment path (4, 8 or 16 lanes) equals the scalar functions bit for bit") {
+    for (std::uint32_t seed = 1; seed <= 1500; ++seed) {
+        check_program(seed, BrdfModel::Default);
+        check_program(seed, BrdfModel::Gltf);
+    }
+}
+
+TEST_CASE("block material sampling equals sample_material bit for bit") {
+    for (std::uint32_t seed = 1; seed <= 1000; ++seed) {
+        check_material<16>(seed);
+        check_material<8>(seed);
+        check_material<4>(seed);
+    }
+}
+}
