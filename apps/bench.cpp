@@ -52,7 +52,7 @@ struct FlatProgram {
 
 double render_flat(Renderer& renderer, const Scene& scene, const Camera& cam, Framebuffer& fb) {
     auto t0 = std::chrono::steady_clock::now();
-    fb.clear(0, 0, 0, 1);
+    renderer.clear(fb, 0, 0, 0, 1);
     renderer.begin_frame();
     glm::mat4 vp = cam.view_projection(float(fb.width) / float(fb.height));
     for (const Mesh& m : scene.meshes) {

@@ -40,6 +40,9 @@ public:
     int tile_size() const { return tile_size_; }
     ThreadPool& pool() { return pool_; }
 
+    // Clears colour and depth with the pool's threads (rows in chunks).
+    void clear(Framebuffer& fb, float r, float g, float b, float a, float z = 1.0f);
+
     // Counters accumulate over draws until the next begin_frame().
     void begin_frame() { stats_ = FrameStats{}; tile_entries_.clear(); }
     const FrameStats& stats() const { return stats_; }

@@ -92,7 +92,7 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
 }
 
 void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb) {
-    fb.clear(0.0f, 0.0f, 0.0f, 1.0f);
+    renderer_.clear(fb, 0.0f, 0.0f, 0.0f, 1.0f);
     renderer_.begin_frame();
     ShadingContext ctx;
     ctx.eye = s.camera.eye;
