@@ -20,16 +20,7 @@ namespace {
 
 glm::vec3 sum_lobes(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx,
                     bool specular) {
-    BrdfInputs bi;
-    bi.n = ms.N;
-    glm::vec3 v = ctx.eye - sp.P;
-    float len = glm::length(v);
-    bi.v = len > 0.0f ? v / len : ms.N;
-    bi.albedo = ms.albedo;
-    bi.metallic = ms.metallic;
-    bi.roughness = ms.roughness;
-    bi.ior = ms.ior;
-    bi.conductor = ms.conductor;
+    BrdfInputs bi = brdf_inputs(ms, sp, ctx);
     glm::vec3 sum(0.0f);
     for (const ShadingLight& L : ctx.lights) {
         glm::vec3 radiance;
@@ -41,16 +32,7 @@ glm::vec3 sum_lobes(const MaterialSample& ms, const SurfacePoint& sp, const Shad
 }
 
 BrdfTerms first_light_terms(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx) {
-    BrdfInputs bi;
-    bi.n = ms.N;
-    glm::vec3 v = ctx.eye - sp.P;
-    float len = glm::length(v);
-    bi.v = len > 0.0f ? v / len : ms.N;
-    bi.albedo = ms.albedo;
-    bi.metallic = ms.metallic;
-    bi.roughness = ms.roughness;
-    bi.ior = ms.ior;
-    bi.conductor = ms.conductor;
+    BrdfInputs bi = brdf_inputs(ms, sp, ctx);
     if (ctx.lights.empty()) return BrdfTerms{};
     glm::vec3 radiance;
     light_at(ctx.lights[0], sp.P, bi.l, radiance);

@@ -170,8 +170,9 @@ inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoin
     return s;
 }
 
-inline glm::vec3 shade_surface(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx,
-                               std::vector<BrdfTerms>* terms = nullptr) {
+// The BRDF inputs at a point, all but the light direction: shade_surface,
+// the debug views and the stepper build them the same way.
+inline BrdfInputs brdf_inputs(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx) {
     BrdfInputs in;
     in.n = ms.N;
     in.v = surface_detail::safe_normalize(ctx.eye - sp.P, ms.N);
@@ -180,6 +181,12 @@ inline glm::vec3 shade_surface(const MaterialSample& ms, const SurfacePoint& sp,
     in.roughness = ms.roughness;
     in.ior = ms.ior;
     in.conductor = ms.conductor;
+    return in;
+}
+
+inline glm::vec3 shade_surface(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx,
+                               std::vector<BrdfTerms>* terms = nullptr) {
+    BrdfInputs in = brdf_inputs(ms, sp, ctx);
     glm::vec3 Lo = ms.emissive;
     if (terms) terms->clear();
     for (const ShadingLight& L : ctx.lights) {
