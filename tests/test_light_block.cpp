@@ -7,16 +7,13 @@
 #include <random>
 
 #include "shading/light_block.h"
+#include "tests/shading_test_util.h"
 
 using namespace prast;
+using prast::test::add_test_lights;
+using prast::test::bits;
 
 namespace {
-
-std::uint32_t bits(float f) {
-    std::uint32_t u;
-    std::memcpy(&u, &f, 4);
-    return u;
-}
 
 void check_block(BrdfModel model, std::uint32_t seed) {
     std::mt19937 rng(seed);
@@ -25,13 +22,7 @@ void check_block(BrdfModel model, std::uint32_t seed) {
     ctx.eye = {sym(rng) * 3, 2.0f + uni(rng), 5.0f};
     ctx.model = model;
     ctx.ambient = {0.03f, 0.04f, 0.05f};
-    ShadingLight sun, lamp, lamp_at_p;
-    sun.direction = glm::normalize(glm::vec3(sym(rng), 1.0f, sym(rng)));
-    sun.radiance = {3.0f, 2.5f, 2.0f};
-    lamp.point = true;
-    lamp.position = {1.0f, 2.0f, 3.0f};
-    lamp.radiance = {10.0f, 12.0f, 14.0f};
-    ctx.lights = {sun, lamp};
+    add_test_lights(ctx, rng);
 
     MaterialBlock mb;
     mb.ior = 1.3f + uni(rng);
@@ -46,7 +37,8 @@ void check_block(BrdfModel model, std::uint32_t seed) {
         mb.er[l] = uni(rng) * 0.1f; mb.eg[l] = 0.0f; mb.eb[l] = uni(rng) * 0.1f;
     }
     // A lane sitting on the point light and one at the eye: the guarded paths.
-    mb.Px[3] = lamp.position.x; mb.Py[3] = lamp.position.y; mb.Pz[3] = lamp.position.z;
+    const glm::vec3 lamp = ctx.lights[1].position;
+    mb.Px[3] = lamp.x; mb.Py[3] = lamp.y; mb.Pz[3] = lamp.z;
     mb.Px[7] = ctx.eye.x; mb.Py[7] = ctx.eye.y; mb.Pz[7] = ctx.eye.z;
 
     RadianceBlock rb;

@@ -17,16 +17,13 @@
 #include "shading/material_lanes.h"
 #include "shading/pbr_program.h"
 #include "shading/sample_lanes.h"
+#include "tests/shading_test_util.h"
 
 using namespace prast;
+using prast::test::add_test_lights;
+using prast::test::bits;
 
 namespace {
-
-std::uint32_t bits(float f) {
-    std::uint32_t u;
-    std::memcpy(&u, &f, 4);
-    return u;
-}
 
 Texture random_texture(std::mt19937& rng, int w, int h, Wrap s, Wrap t) {
     std::uniform_real_distribution<float> uni(0.0f, 1.0f);
@@ -258,13 +255,7 @@ void check_program(std::uint32_t seed, BrdfModel model) {
     ShadingContext ctx;
     ctx.eye = {sym(rng), 2.0f, 5.0f};
     ctx.model = model;
-    ShadingLight sun, lamp;
-    sun.direction = glm::normalize(glm::vec3(sym(rng), 1.0f, sym(rng)));
-    sun.radiance = {3.0f, 2.5f, 2.0f};
-    lamp.point = true;
-    lamp.position = {1.0f, 2.0f, 3.0f};
-    lamp.radiance = {10.0f, 12.0f, 14.0f};
-    ctx.lights = {sun, lamp};
+    add_test_lights(ctx, rng);
 
     PbrProgram prog;
     prog.material = &bm;
