@@ -60,11 +60,15 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
         try {
             Image img = src.decoded ? *src.decoded : decode_image(src, srgb);
             // Wrap modes live on the reference; the first user's are used.
-            Wrap ws = Wrap::Repeat, wt = Wrap::Repeat;
-            for (const Material& m : scene.materials)
-                for (const TextureRef* r : {&m.base_color, &m.emissive, &m.metallic_roughness, &m.roughness,
-                                            &m.metallic, &m.normal, &m.occlusion})
-                    if (std::size_t(r->image) == slot / 2) { ws = r->wrap_s; wt = r->wrap_t; }
+            auto first_user = [&]() -> const TextureRef* {
+                for (const Material& m : scene.materials)
+                    for (const TextureRef* r : {&m.base_color, &m.emissive, &m.metallic_roughness, &m.roughness,
+                                                &m.metallic, &m.normal, &m.occlusion})
+                        if (std::size_t(r->image) == slot / 2) return r;
+                return nullptr;
+            };
+            const TextureRef* user = first_user();
+            Wrap ws = user ? user->wrap_s : Wrap::Repeat, wt = user ? user->wrap_t : Wrap::Repeat;
             textures_[slot] = std::make_unique<Texture>(Texture::from_image(std::move(img), ws, wt));
         } catch (const std::exception& e) {
             errors[slot] = e.what();
