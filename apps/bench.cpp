@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "shading/default_scene.h"
-#include "shading/load_scene.h"
+#include "scene/default_scene.h"
+#include "scene/load_scene.h"
 #include "shading/scene_renderer.h"
 
 using namespace prast;

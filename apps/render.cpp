@@ -26,10 +26,10 @@
 
 #include "apps/render_options.h"
 #include "raster/pipeline.h"
-#include "shading/camera.h"
-#include "shading/default_scene.h"
-#include "shading/image_write.h"
-#include "shading/load_scene.h"
+#include "scene/camera.h"
+#include "scene/default_scene.h"
+#include "scene/write_image.h"
+#include "scene/load_scene.h"
 #include "shading/scene_renderer.h"
 #include "shading/tonemap.h"
 

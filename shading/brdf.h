@@ -16,7 +16,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/constants.hpp>
 
-#include "shading/scene.h"
+#include "scene/scene.h"
 
 namespace prast {
 

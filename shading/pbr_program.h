@@ -11,7 +11,7 @@
 
 #include "raster/fragment.h"
 #include "shading/debug_view.h"
-#include "shading/scene.h"
+#include "scene/scene.h"
 #include "shading/surface.h"
 
 namespace prast {

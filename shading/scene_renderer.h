@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "raster/pipeline.h"
-#include "shading/camera.h"
+#include "scene/camera.h"
 #include "shading/debug_view.h"
 #include "shading/pbr_program.h"
-#include "shading/scene.h"
+#include "scene/scene.h"
 #include "shading/surface.h"
 #include "shading/texture.h"
 

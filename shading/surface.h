@@ -10,7 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "shading/brdf.h"
-#include "shading/scene.h"
+#include "scene/scene.h"
 #include "shading/texture.h"
 
 namespace prast {

@@ -1,6 +1,5 @@
-// Textures: decoding image files to linear float RGBA (stb_image), the
-// box-filtered mip chain, and the bilinear / trilinear samplers the shaders call
-// per pixel. Also the procedural images of the built-in default scene.
+// Textures: the box-filtered mip chain of a decoded image (scene/image.h) and
+// the bilinear / trilinear samplers the shaders call per pixel.
 //
 // Conventions (conventions.md, "Textures"): texel centres at (i + 0.5) / width,
 // v = 0 is the TOP row of the image (the project's internal UVs; no flipping
@@ -19,37 +18,10 @@
 
 #include <glm/glm.hpp>
 
-#include "shading/scene.h"
+#include "scene/image.h"
+#include "scene/scene.h"
 
 namespace prast {
-
-// Linear float RGBA, 4 floats per texel, row-major, row 0 = top row of the file.
-struct Image {
-    int width = 0, height = 0;
-    std::vector<float> rgba;
-
-    bool empty() const { return width <= 0 || height <= 0; }
-    glm::vec4 at(int x, int y) const {
-        const float* p = &rgba[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4];
-        return {p[0], p[1], p[2], p[3]};
-    }
-    void set(int x, int y, const glm::vec4& c) {
-        float* p = &rgba[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4];
-        p[0] = c.r; p[1] = c.g; p[2] = c.b; p[3] = c.a;
-    }
-};
-
-// Images larger than this are refused before anything is allocated: 2^28
-// texels is 4 GiB as float RGBA, far beyond any sane texture.
-constexpr std::int64_t kMaxImageTexels = std::int64_t(1) << 28;
-
-// Decodes src.bytes when not empty, else the file src.path (PNG, JPEG, HDR and
-// whatever else stb_image reads). 8-bit and 16-bit colour channels are sRGB-
-// decoded when `srgb` (alpha never is), else scaled to [0, 1]; HDR (Radiance)
-// data is linear and kept as is. Grey -> (g, g, g, 1), grey+alpha -> (g, g, g, a),
-// RGB -> (r, g, b, 1). Throws LoadError "NAME: reason" (NAME = src.name, or the
-// path) for a missing, unreadable, empty, corrupt, zero-sized or oversized image.
-Image decode_image(const ImageSource& src, bool srgb);
 
 class Texture {
 public:
@@ -123,21 +95,6 @@ private:
     int level_count_ = 0;
     Wrap wrap_s_ = Wrap::Repeat, wrap_t_ = Wrap::Repeat;
 };
-
-// ---- Procedural images (linear values, deterministic, seamless under Repeat).
-
-// size x size, cells x cells squares; the top-left cell is `a`.
-Image make_checker(int size, int cells, glm::vec4 a, glm::vec4 b);
-// Running-bond bricks (4 across, 8 rows per tile of the texture) in a palette
-// of ceramic colours, a few of them gold, with grey grout. Linear colour.
-Image make_tiles_albedo(int size);
-// The matching tangent-space normal map (OpenGL convention: green points up
-// the image, towards -v), encoded 0.5 * n + 0.5: bevelled brick edges,
-// concave grout grooves, each brick slightly tilted.
-Image make_tiles_normal(int size);
-// ORM packing: R = ambient occlusion (grout darker), G = roughness (glazed
-// bricks smooth-ish, grout rough), B = metallic (1 on the gold bricks).
-Image make_tiles_roughness_metal(int size);
 
 // ---- Inline sampling (the per-pixel hot path).
 

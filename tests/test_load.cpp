@@ -20,8 +20,8 @@
 
 #include "tests/scratch.h"
 
-#include "shading/load_scene.h"
-#include "shading/tangents.h"
+#include "scene/load_scene.h"
+#include "scene/tangents.h"
 
 namespace fs = std::filesystem;
 using namespace prast;

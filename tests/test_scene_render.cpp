@@ -11,9 +11,9 @@
 
 #include <stb_image.h>
 
-#include "shading/default_scene.h"
-#include "shading/image_write.h"
-#include "shading/load_scene.h"
+#include "scene/default_scene.h"
+#include "scene/write_image.h"
+#include "scene/load_scene.h"
 #include "shading/scene_renderer.h"
 #include "shading/tonemap.h"
 

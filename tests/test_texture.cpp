@@ -16,6 +16,8 @@
 
 #include "tests/scratch.h"
 
+#include "scene/image.h"
+#include "scene/procedural_images.h"
 #include "shading/texture.h"
 
 namespace fs = std::filesystem;

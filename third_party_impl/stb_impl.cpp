@@ -1,5 +1,5 @@
 // The one translation unit that compiles stb_image and stb_image_write.
-// Large or hostile images are refused before allocation (see shading/image_io).
+// Large or hostile images are refused before allocation (see scene/image.cpp).
 #define STBI_MAX_DIMENSIONS (1 << 15)
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_IMPLEMENTATION

@@ -1,5 +1,5 @@
 // The one translation unit that compiles tinygltf. Images are decoded by our own
-// loader (shading/), so tinygltf only keeps their bytes; stb_image is compiled
+// loader (scene/image.cpp), so tinygltf only keeps their bytes; stb_image is compiled
 // once in stb_impl.cpp.
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_STB_IMAGE

@@ -1,5 +1,5 @@
 // Atomic PNG/HDR output; see image_write.h.
-#include "shading/image_write.h"
+#include "scene/write_image.h"
 
 #include <cerrno>
 #include <cstdio>

@@ -1,6 +1,6 @@
 // The scene as loaders produce it and renderers consume it: world-space meshes
 // (node transforms already applied), metal-roughness materials, image sources
-// (decoded later by texture.h) and punctual lights.
+// (decoded later by image.h) and punctual lights.
 //
 // UV convention inside the project: glTF's, v = 0 is the TOP row of an image.
 // The OBJ loader converts (v_internal = 1 - v_obj), so samplers and tangent
@@ -18,7 +18,7 @@
 
 namespace prast {
 
-struct Image;  // texture.h
+struct Image;  // image.h
 
 // A bad input file: what() is one line, "FILE: problem".
 struct LoadError : std::runtime_error {
@@ -26,7 +26,7 @@ struct LoadError : std::runtime_error {
 };
 
 // Where an image's bytes come from: a file on disk, or bytes embedded in a
-// .glb / data URI. Decoding happens in texture.h.
+// .glb / data URI. Decoding happens in image.h.
 struct ImageSource {
     std::string path;                 // file path, empty when embedded
     std::vector<unsigned char> bytes; // embedded encoded bytes (PNG/JPEG)

@@ -8,7 +8,7 @@
 // builds tangents from raw glTF UVs must use B = -dP/dv_glTF").
 #pragma once
 
-#include "shading/scene.h"
+#include "scene/scene.h"
 
 namespace prast {
 

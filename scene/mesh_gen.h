@@ -4,7 +4,7 @@
 
 #include <glm/glm.hpp>
 
-#include "shading/scene.h"
+#include "scene/scene.h"
 
 namespace prast {
 

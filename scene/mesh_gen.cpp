@@ -1,5 +1,5 @@
 // Procedural meshes; see mesh_gen.h.
-#include "shading/mesh_gen.h"
+#include "scene/mesh_gen.h"
 
 #include <cmath>
 

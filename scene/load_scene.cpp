@@ -1,6 +1,6 @@
 // The format dispatch and what the OBJ and glTF loaders share: reading a file
 // defensively and the final clean-up of the meshes (finish_scene).
-#include "shading/load_scene.h"
+#include "scene/load_scene.h"
 
 #include <algorithm>
 #include <cctype>
@@ -11,7 +11,7 @@
 #include <system_error>
 #include <utility>
 
-#include "shading/tangents.h"
+#include "scene/tangents.h"
 
 namespace prast {
 

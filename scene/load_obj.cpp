@@ -7,7 +7,7 @@
 // for the keys ourselves; the scan also reads the non-standard conductor key
 // `Pc gold|copper|aluminium|silver`, which tinyobjloader takes for a clearcoat
 // number.
-#include "shading/load_scene.h"
+#include "scene/load_scene.h"
 
 #include <cctype>
 #include <cmath>
@@ -22,7 +22,7 @@
 
 #include <tiny_obj_loader.h>
 
-#include "shading/tangents.h"
+#include "scene/tangents.h"
 
 namespace prast {
 

@@ -1,5 +1,5 @@
 // Camera matrices and framing; see camera.h.
-#include "shading/camera.h"
+#include "scene/camera.h"
 
 #include <algorithm>
 #include <cmath>

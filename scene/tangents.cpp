@@ -1,7 +1,7 @@
 // Smooth normals and UV-derived tangent frames (see tangents.h). Sums are kept
 // in double so that millimetre-sized triangles of a scanned mesh do not lose
 // their direction to rounding.
-#include "shading/tangents.h"
+#include "scene/tangents.h"
 
 #include <algorithm>
 #include <cmath>

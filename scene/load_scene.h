@@ -1,7 +1,7 @@
 // Scene loading: Wavefront OBJ + MTL (tinyobjloader) and glTF 2.0 (.gltf with
 // external or data-URI buffers, and .glb; tinygltf) into the world-space Scene
 // of scene.h. Images are not decoded here: the loaders fill ImageSource with a
-// path or the encoded bytes, and texture.h decodes them.
+// path or the encoded bytes, and scene/image.h decodes them.
 //
 // Errors: a file that cannot be used throws LoadError with one line
 // "FILE: problem". A problem the loader can work around (a missing texture, an
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "shading/scene.h"
+#include "scene/scene.h"
 
 namespace prast {
 

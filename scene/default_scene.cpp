@@ -1,10 +1,10 @@
 // The built-in scene; see default_scene.h.
-#include "shading/default_scene.h"
+#include "scene/default_scene.h"
 
 #include <memory>
 
-#include "shading/mesh_gen.h"
-#include "shading/texture.h"
+#include "scene/mesh_gen.h"
+#include "scene/procedural_images.h"
 
 namespace prast {
 

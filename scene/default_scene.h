@@ -1,12 +1,12 @@
 // The built-in scene `render` draws with no arguments: a grid of spheres that
 // sweeps roughness (columns, 0 to 1) against metallic (rows, 0 to 1), standing
 // on a floor of tiles whose albedo, normal and roughness/metal maps are made by
-// code here (texture.h generators), lit by a sun and a point light. No
+// code here (procedural_images.h), lit by a sun and a point light. No
 // third-party file is involved.
 #pragma once
 
-#include "shading/camera.h"
-#include "shading/scene.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
 
 namespace prast {
 

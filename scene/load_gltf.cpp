@@ -11,7 +11,7 @@
 //    byteOffset/byteLength against the buffer: the callback ignores those bytes
 //    and they are copied here after a bounds check.
 // Images are never decoded here (tinygltf is built without stb_image).
-#include "shading/load_scene.h"
+#include "scene/load_scene.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,237 @@
+// The procedural images of the built-in scene: a checker and the brick-tile
+// albedo, normal and occlusion/roughness/metal maps; see procedural_images.h.
+#include "scene/procedural_images.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace prast {
+
+namespace {
+
+void check_size(const char* what, int size) {
+    if (size < 1 || size > 16384)
+        throw std::invalid_argument(std::string(what) + ": size " + std::to_string(size) +
+                                    " out of range [1, 16384]");
+}
+
+// An integer hash with good avalanche (xorshift-multiply rounds, after Chris
+// Wellons' "lowbias32" constants).
+std::uint32_t hash_u32(std::uint32_t x) {
+    x ^= x >> 16;
+    x *= 0x7feb352dU;
+    x ^= x >> 15;
+    x *= 0x846ca68bU;
+    x ^= x >> 16;
+    return x;
+}
+
+std::uint32_t hash3(int x, int y, std::uint32_t seed) {
+    return hash_u32(std::uint32_t(x) * 0x9E3779B1U ^ hash_u32(std::uint32_t(y) + seed * 0x85EBCA77U));
+}
+
+float unit_float(std::uint32_t h) { return float(h >> 8) * (1.0f / 16777216.0f); }  // [0, 1)
+
+// Smooth value noise in [0, 1) with `period` lattice cells across [0, 1), so
+// it tiles seamlessly.
+float value_noise(glm::vec2 uv, int period, std::uint32_t seed) {
+    const float x = uv.x * float(period), y = uv.y * float(period);
+    const float fx = std::floor(x), fy = std::floor(y);
+    const int ix = int(fx), iy = int(fy);
+    auto lattice = [&](int i, int j) {
+        return unit_float(hash3(((i % period) + period) % period, ((j % period) + period) % period, seed));
+    };
+    auto smooth = [](float t) { return t * t * (3.0f - 2.0f * t); };
+    const float sx = smooth(x - fx), sy = smooth(y - fy);
+    const float top = lattice(ix, iy) + (lattice(ix + 1, iy) - lattice(ix, iy)) * sx;
+    const float bottom = lattice(ix, iy + 1) + (lattice(ix + 1, iy + 1) - lattice(ix, iy + 1)) * sx;
+    return top + (bottom - top) * sy;
+}
+
+// Brick layout, in brick heights H = 1/8 of the texture: 4 bricks (2H wide)
+// across, 8 rows, odd rows shifted by half a brick (running bond). Both counts
+// divide the texture, so the pattern tiles under Repeat.
+constexpr int kBrickCols = 4, kBrickRows = 8;
+constexpr float kGroutHalf = 0.06f;  // half the grout joint, in H
+constexpr float kBevel = 0.10f;      // width of the rounded brick edge, in H
+
+enum class Zone { Grout, Bevel, Face };
+
+struct BrickPoint {
+    std::uint32_t id = 0;  // hash of the (wrapped) brick coordinates
+    Zone zone = Zone::Face;
+    float t = 0.0f;        // position across the zone, 0 at its inner (grout-side) edge
+    glm::vec2 inward{0.0f};  // uv direction in which the distance to the brick edge grows
+};
+
+BrickPoint brick_at(glm::vec2 uv) {
+    const float ry = uv.y * float(kBrickRows);
+    const float row = std::floor(ry), fy = ry - row;
+    const int irow = int(row);
+    const float rx = uv.x * float(kBrickCols) + ((irow & 1) ? 0.5f : 0.0f);
+    const float col = std::floor(rx), fx = rx - col;
+    const int icol = int(col);
+
+    BrickPoint p;
+    p.id = hash3(((icol % kBrickCols) + kBrickCols) % kBrickCols,
+                 ((irow % kBrickRows) + kBrickRows) % kBrickRows, 17U);
+    // Distances to the nearest vertical and horizontal brick edges, in H.
+    const float dx = std::min(fx, 1.0f - fx) * 2.0f;
+    const float dy = std::min(fy, 1.0f - fy);
+    float d;
+    if (dx < dy) {
+        d = dx;
+        p.inward = glm::vec2(fx < 0.5f ? 1.0f : -1.0f, 0.0f);
+    } else {
+        d = dy;
+        p.inward = glm::vec2(0.0f, fy < 0.5f ? 1.0f : -1.0f);
+    }
+    if (d < kGroutHalf) {
+        p.zone = Zone::Grout;
+        p.t = d / kGroutHalf;
+    } else if (d < kGroutHalf + kBevel) {
+        p.zone = Zone::Bevel;
+        p.t = (d - kGroutHalf) / kBevel;
+    } else {
+        p.zone = Zone::Face;
+        p.t = 1.0f;
+    }
+    return p;
+}
+
+struct BrickLook {
+    glm::vec3 albedo;
+    float roughness;
+    float metallic;
+    glm::vec2 tilt;  // height gradient of the brick face (a slightly uneven lay)
+};
+
+BrickLook brick_look(std::uint32_t id) {
+    // Glazed ceramic colours, linear.
+    static const glm::vec3 palette[5] = {
+        {0.42f, 0.11f, 0.05f},  // terracotta
+        {0.60f, 0.46f, 0.28f},  // sand
+        {0.09f, 0.13f, 0.21f},  // slate blue
+        {0.19f, 0.29f, 0.17f},  // sage
+        {0.74f, 0.69f, 0.57f},  // cream
+    };
+    BrickLook look;
+    const float pick = unit_float(hash_u32(id ^ 0x1234567U));
+    if (pick < 0.1f) {  // a few gold bricks show off the metallic path
+        look.albedo = glm::vec3(1.0f, 0.766f, 0.336f);
+        look.metallic = 1.0f;
+        look.roughness = 0.25f;
+    } else {
+        const int k = int(hash_u32(id ^ 0xABCDEFU) % 5U);
+        look.albedo = palette[k] * (0.85f + 0.3f * unit_float(hash_u32(id ^ 0x55AA55U)));
+        look.metallic = 0.0f;
+        look.roughness = 0.25f + 0.2f * unit_float(hash_u32(id ^ 0x777U));
+    }
+    look.tilt = glm::vec2(unit_float(hash_u32(id ^ 0x9E37U)) - 0.5f,
+                          unit_float(hash_u32(id ^ 0x79B9U)) - 0.5f) * 0.06f;
+    return look;
+}
+
+// Renders f(uv) -> vec4 with 2x2 sub-samples per texel averaged: smoother
+// grout edges at small sizes; the mip chain does the rest.
+template <class F>
+Image render_procedural(int size, F f) {
+    Image img;
+    img.width = img.height = size;
+    img.rgba.assign(std::size_t(size) * std::size_t(size) * 4, 0.0f);
+    const float inv = 1.0f / float(size);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            glm::vec4 sum(0.0f);
+            for (int sy = 0; sy < 2; ++sy)
+                for (int sx = 0; sx < 2; ++sx)
+                    sum += f(glm::vec2((float(x) + 0.25f + 0.5f * float(sx)) * inv,
+                                       (float(y) + 0.25f + 0.5f * float(sy)) * inv));
+            img.set(x, y, sum * 0.25f);
+        }
+    return img;
+}
+
+constexpr float kGroutAlbedo = 0.28f;
+
+} // namespace
+
+Image make_checker(int size, int cells, glm::vec4 a, glm::vec4 b) {
+    check_size("make_checker", size);
+    if (cells < 1 || cells > size)
+        throw std::invalid_argument("make_checker: cells " + std::to_string(cells) +
+                                    " out of range [1, size]");
+    Image img;
+    img.width = img.height = size;
+    img.rgba.assign(std::size_t(size) * std::size_t(size) * 4, 0.0f);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const int cx = int(std::int64_t(x) * cells / size), cy = int(std::int64_t(y) * cells / size);
+            img.set(x, y, ((cx + cy) & 1) ? b : a);
+        }
+    return img;
+}
+
+Image make_tiles_albedo(int size) {
+    check_size("make_tiles_albedo", size);
+    return render_procedural(size, [](glm::vec2 uv) {
+        const BrickPoint p = brick_at(uv);
+        if (p.zone == Zone::Grout) {
+            const float grit = value_noise(uv, 128, 3U);
+            return glm::vec4(glm::vec3(kGroutAlbedo * (0.8f + 0.4f * grit)), 1.0f);
+        }
+        const BrickLook look = brick_look(p.id);
+        const float mottle = value_noise(uv, 32, 5U);
+        // Edges slightly darker where the glaze runs thin.
+        const float edge = p.zone == Zone::Bevel ? 0.85f + 0.15f * p.t : 1.0f;
+        return glm::vec4(glm::min(look.albedo * ((0.92f + 0.16f * mottle) * edge), glm::vec3(1.0f)), 1.0f);
+    });
+}
+
+Image make_tiles_normal(int size) {
+    check_size("make_tiles_normal", size);
+    Image img = render_procedural(size, [](glm::vec2 uv) {
+        const BrickPoint p = brick_at(uv);
+        // Height gradient (dh/du, dh/dv), as a slope per unit distance.
+        glm::vec2 grad(0.0f);
+        switch (p.zone) {
+        case Zone::Grout:  // concave groove: flat in the middle, rising to the brick
+            grad = p.inward * (0.3f * p.t);
+            break;
+        case Zone::Bevel:  // rounded edge: steepest next to the grout, flat at the face
+            grad = p.inward * (1.1f * (1.0f - p.t)) + brick_look(p.id).tilt;
+            break;
+        case Zone::Face:
+            grad = brick_look(p.id).tilt;
+            break;
+        }
+        // Tangent space: x along T = +u, y along B = -v (up the image), so
+        // n = (-dh/du, +dh/dv, 1), normalised.
+        return glm::vec4(glm::normalize(glm::vec3(-grad.x, grad.y, 1.0f)), 0.0f);
+    });
+    // Renormalise the averaged sub-samples and encode 0.5 n + 0.5.
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const glm::vec3 n = glm::normalize(glm::vec3(img.at(x, y)));
+            img.set(x, y, glm::vec4(n * 0.5f + 0.5f, 1.0f));
+        }
+    return img;
+}
+
+Image make_tiles_roughness_metal(int size) {
+    check_size("make_tiles_roughness_metal", size);
+    return render_procedural(size, [](glm::vec2 uv) {
+        const BrickPoint p = brick_at(uv);
+        if (p.zone == Zone::Grout) {
+            const float grit = value_noise(uv, 128, 3U);
+            return glm::vec4(0.55f + 0.15f * p.t, 0.85f + 0.1f * grit, 0.0f, 1.0f);
+        }
+        const BrickLook look = brick_look(p.id);
+        const float ao = p.zone == Zone::Bevel ? 0.85f + 0.15f * p.t : 1.0f;
+        const float wear = value_noise(uv, 32, 9U);
+        return glm::vec4(ao, look.roughness * (0.9f + 0.2f * wear), look.metallic, 1.0f);
+    });
+}
+
+} // namespace prast

@@ -1,0 +1,24 @@
+// Procedural images for the built-in scene (linear values, deterministic,
+// seamless under Repeat): made by code, so no third-party file is involved.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "scene/image.h"
+
+namespace prast {
+
+// size x size, cells x cells squares; the top-left cell is `a`.
+Image make_checker(int size, int cells, glm::vec4 a, glm::vec4 b);
+// Running-bond bricks (4 across, 8 rows per tile of the texture) in a palette
+// of ceramic colours, a few of them gold, with grey grout. Linear colour.
+Image make_tiles_albedo(int size);
+// The matching tangent-space normal map (OpenGL convention: green points up
+// the image, towards -v), encoded 0.5 * n + 0.5: bevelled brick edges,
+// concave grout grooves, each brick slightly tilted.
+Image make_tiles_normal(int size);
+// ORM packing: R = ambient occlusion (grout darker), G = roughness (glazed
+// bricks smooth-ish, grout rough), B = metallic (1 on the gold bricks).
+Image make_tiles_roughness_metal(int size);
+
+} // namespace prast
