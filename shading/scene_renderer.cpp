@@ -101,6 +101,7 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
     renderer_.begin_frame();
     FrameOptions frame;  // cleared to black, alpha 1, depth 1, in the tile pass
     frame.samples = s.samples;
+    frame.visibility = s.visibility;
     renderer_.begin(fb, frame);
     ShadingContext ctx;
     ctx.eye = s.camera.eye;

@@ -25,6 +25,8 @@ struct FrameSettings {
     BrdfModel model = BrdfModel::Default;
     DebugView view = DebugView::None;
     int samples = 1;  // per pixel: 1, 2, 4 or 8 (README "Anti-aliasing")
+    // Where the visibility pass runs (the bytes are the same either way).
+    FrameOptions::Visibility visibility = FrameOptions::Visibility::Auto;
 };
 
 // The 8-bit image a frame writes from its tile pass (render's PNG): exposure,
