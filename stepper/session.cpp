@@ -295,15 +295,18 @@ Reply Session::cost() {
         record_frame(s_, r);
         record_ms.push_back(r.record_ms);
     }
+    char buf[512];
+    const double plain = median(plain_ms), recorded = median(record_ms);
+    std::snprintf(buf, sizeof buf,
+                  "cost of a recording, %dx%d, %d thread%s, median of %d frames:\n"
+                  "  plain frame (SceneRenderer::render) %.1f ms\n"
+                  "  recorded frame %.1f ms (%.2fx)\n"
+                  "  recording %zu bytes (%.1f MiB), plus the frame's own framebuffer %zu bytes\n",
+                  rec_.width, rec_.height, s_.renderer->threads(), s_.renderer->threads() == 1 ? "" : "s", kRuns,
+                  plain, recorded, recorded / plain, rec_.bytes(), double(rec_.bytes()) / 1048576.0,
+                  (rec_.fb.color.size() + rec_.fb.depth.size()) * sizeof(float));
     std::ostringstream o;
-    o << "cost of a recording, " << rec_.width << "x" << rec_.height << ", " << s_.renderer->threads()
-      << " threads, median of " << kRuns << " frames:\n"
-      << "  plain frame (SceneRenderer::render) " << num(median(plain_ms)) << " ms\n"
-      << "  recorded frame " << num(median(record_ms)) << " ms (" << num(median(record_ms) / median(plain_ms))
-      << "x)\n"
-      << "  recording " << rec_.bytes() << " bytes (" << num(double(rec_.bytes()) / 1048576.0)
-      << " MiB), plus the frame's own framebuffer "
-      << (rec_.fb.color.size() + rec_.fb.depth.size()) * sizeof(float) << " bytes\n";
+    o << buf;
     return Reply{true, false, o.str()};
 }
 

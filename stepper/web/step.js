@@ -82,8 +82,8 @@ async function showPixel(x, y) {
     body.textContent = "";
     p.history.forEach((h, i) => {
       const tr = document.createElement("tr");
-      const cells = [String(i + 1), null, h.mesh, String(h.depth), h.result,
-                     h.out ? "(" + h.out.join(", ") + ")" : ""];
+      const cells = [String(i + 1), null, h.mesh, h.depth.toPrecision(7), h.result,
+                     h.out ? "(" + h.out.map((v) => v.toPrecision(6)).join(", ") + ")" : ""];
       cells.forEach((c, k) => {
         const td = document.createElement("td");
         if (k === 1) td.appendChild(triLink(h.tri)); else td.textContent = c;
