@@ -1,5 +1,5 @@
-// Image decoding: stb_image (PNG, JPEG, HDR, ...) to linear float RGBA, with
-// sRGB colour channels decoded first; see image.h.
+// Image decoding: stb_image (PNG, JPEG, HDR, ...); 8-bit files keep their
+// bytes, 16-bit and HDR files become linear float RGBA; see image.h.
 #include "scene/image.h"
 
 #include <array>
@@ -23,14 +23,6 @@ float srgb_to_linear(float c) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
-const std::array<float, 256>& srgb_table() {
-    static const std::array<float, 256> table = [] {
-        std::array<float, 256> t{};
-        for (int i = 0; i < 256; ++i) t[i] = srgb_to_linear(float(i) / 255.0f);
-        return t;
-    }();
-    return table;
-}
 
 std::string stbi_reason() {
     const char* r = stbi_failure_reason();
@@ -96,6 +88,24 @@ void expand_to_rgba(const T* src, int comp, std::size_t count, float* dst, Colou
 
 } // namespace
 
+const float* srgb8_decode_table() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i) t[i] = srgb_to_linear(float(i) / 255.0f);
+        return t;
+    }();
+    return table.data();
+}
+
+const float* unorm8_decode_table() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i) t[i] = float(i) / 255.0f;
+        return t;
+    }();
+    return table.data();
+}
+
 Image decode_image(const ImageSource& src, bool srgb) {
     const std::string name = !src.name.empty()   ? src.name
                              : !src.path.empty() ? src.path
@@ -143,7 +153,6 @@ Image decode_image(const ImageSource& src, bool srgb) {
             throw LoadError(name + ": inconsistent image header");
         img.width = w;
         img.height = h;
-        img.rgba.resize(std::size_t(texels) * 4);
     };
     const std::size_t count = std::size_t(texels);
     const auto unit = [](float c) { return c; };
@@ -151,22 +160,23 @@ Image decode_image(const ImageSource& src, bool srgb) {
         // Radiance HDR: linear floats, kept as is whatever `srgb` says.
         std::unique_ptr<float, StbiFree> px(stbi_loadf_from_memory(data, len, &dw, &dh, &dcomp, 0));
         check(px.get());
+        img.rgba.resize(count * 4);
         expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), unit, unit);
     } else if (stbi_is_16_bit_from_memory(data, len)) {
         std::unique_ptr<stbi_us, StbiFree> px(stbi_load_16_from_memory(data, len, &dw, &dh, &dcomp, 0));
         check(px.get());
+        img.rgba.resize(count * 4);
         const auto linear = [](stbi_us c) { return float(c) / 65535.0f; };
         const auto decode = [](stbi_us c) { return srgb_to_linear(float(c) / 65535.0f); };
         if (srgb) expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), decode, linear);
         else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
     } else {
+        // 8-bit: the bytes as the file has them; sampling decodes them.
         std::unique_ptr<stbi_uc, StbiFree> px(stbi_load_from_memory(data, len, &dw, &dh, &dcomp, 0));
         check(px.get());
-        const std::array<float, 256>& table = srgb_table();
-        const auto linear = [](stbi_uc c) { return float(c) / 255.0f; };
-        const auto decode = [&table](stbi_uc c) { return table[c]; };
-        if (srgb) expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), decode, linear);
-        else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
+        img.channels = dcomp;
+        img.srgb = srgb;
+        img.pixels.assign(px.get(), px.get() + count * std::size_t(dcomp));
     }
     return img;
 }
