@@ -316,14 +316,63 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
     }
 }
 
+// The stored channels of one 8-bit texel (index i) as a vector, through
+// their tables; channels past C are 0 (never written out).
+template <int C>
+inline Float4 load_unorm8_texel(const std::uint8_t* base, const float* const* table, std::int32_t i) {
+    const std::uint8_t* p = base + std::size_t(i) * C;
+    Float4 r = {0.0f, 0.0f, 0.0f, 0.0f};
+    r[0] = table[0][p[0]];
+    if constexpr (C > 1) r[1] = table[1][p[1]];
+    if constexpr (C > 2) r[2] = table[2][p[2]];
+    if constexpr (C > 3) r[3] = table[3][p[3]];
+    return r;
+}
+
+template <int C>
+inline Float4 bilinear_unorm8_lane(const std::uint8_t* base, const float* const* table,
+                                   const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty, int l) {
+    const Float4 a = load_unorm8_texel<C>(base, table, idx[0][l]), b = load_unorm8_texel<C>(base, table, idx[1][l]);
+    const Float4 c = load_unorm8_texel<C>(base, table, idx[2][l]), d = load_unorm8_texel<C>(base, table, idx[3][l]);
+    const Float4 top = a + (b - a) * tx[l];
+    const Float4 bottom = c + (d - c) * tx[l];
+    return top + (bottom - top) * ty[l];
+}
+
+// The live lanes of an 8-bit texture one at a time (sparse blocks: the
+// gathers would fetch the dead lanes too). The same operations per channel.
+template <int N, int C>
+inline void fetch_unorm8_one_by_one(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+    const float* table[4] = {tex.table(0), tex.table(C > 1 ? 1 : 0), tex.table(C > 2 ? 2 : 0), tex.table(C > 3 ? 3 : 0)};
+    const std::uint8_t* base = tex.unorm8_data();
+    float* dst[4] = {out.r, out.g, out.b, out.a};
+    int sw[4];
+    for (int k = 0; k < 4; ++k) sw[k] = tex.swizzle(k);
+    if (at.live != (1u << N) - 1u)
+        for (int l = 0; l < N; ++l) out.r[l] = out.g[l] = out.b[l] = out.a[l] = 0.0f;
+    for (std::uint32_t m = at.live; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        Float4 c = bilinear_unorm8_lane<C>(base, table, at.ia, at.txa, at.tya, l);
+        if ((at.blend >> l) & 1u) {
+            const Float4 cb = bilinear_unorm8_lane<C>(base, table, at.ib, at.txb, at.tyb, l);
+            c = c + (cb - c) * at.t[l];
+        }
+        for (int k = 0; k < 4; ++k) dst[k][l] = sw[k] == Texture::kOne ? 1.0f : c[sw[k] & 3];
+    }
+}
+
+// Blocks with at most this many live lanes read them one by one.
+constexpr int kSparseLanes = 4;
+
 template <int N>
 inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
     constexpr int W = N >= 8 ? 8 : 4;
+    const bool sparse = __builtin_popcount(at.live) <= kSparseLanes;
     switch (tex.channels()) {
-    case 1: fetch_unorm8_lanes<N, W, 1>(tex, at, out); return;
-    case 2: fetch_unorm8_lanes<N, W, 2>(tex, at, out); return;
-    case 3: fetch_unorm8_lanes<N, W, 3>(tex, at, out); return;
-    default: fetch_unorm8_lanes<N, W, 4>(tex, at, out); return;
+    case 1: sparse ? fetch_unorm8_one_by_one<N, 1>(tex, at, out) : fetch_unorm8_lanes<N, W, 1>(tex, at, out); return;
+    case 2: sparse ? fetch_unorm8_one_by_one<N, 2>(tex, at, out) : fetch_unorm8_lanes<N, W, 2>(tex, at, out); return;
+    case 3: sparse ? fetch_unorm8_one_by_one<N, 3>(tex, at, out) : fetch_unorm8_lanes<N, W, 3>(tex, at, out); return;
+    default: sparse ? fetch_unorm8_one_by_one<N, 4>(tex, at, out) : fetch_unorm8_lanes<N, W, 4>(tex, at, out); return;
     }
 }
 
