@@ -262,7 +262,7 @@ inline typename V::F decode_channel(typename V::I words, int c, const float* tab
 
 // Bilinear filter of every stored channel of one level for lanes [l0, l0 + W).
 template <class V, int C>
-inline void bilinear_unorm8(const Texture& tex, const bool* divide, const std::int32_t (*idx)[kMaxN],
+inline void bilinear_unorm8(const Texture& tex, const bool* divide, unsigned need, const std::int32_t (*idx)[kMaxN],
                             const float* tx_lanes, const float* ty_lanes, int l0, typename V::F* result) {
     using F = typename V::F;
     const std::uint8_t* base = tex.unorm8_data();
@@ -272,6 +272,7 @@ inline void bilinear_unorm8(const Texture& tex, const bool* divide, const std::i
     const typename V::I wd = gather_texels<V, C>(base, V::load_i(idx[3] + l0));
     const F tx = V::load_f(tx_lanes + l0), ty = V::load_f(ty_lanes + l0);
     for (int c = 0; c < C; ++c) {
+        if (!((need >> c) & 1u)) continue;
         const float* table = tex.table(c);
         const F a = decode_channel<V>(wa, c, table, divide[c]), b = decode_channel<V>(wb, c, table, divide[c]);
         const F cc = decode_channel<V>(wc, c, table, divide[c]), d = decode_channel<V>(wd, c, table, divide[c]);
@@ -282,33 +283,41 @@ inline void bilinear_unorm8(const Texture& tex, const bool* divide, const std::i
     }
 }
 
-// All N lanes of an 8-bit texture, W at a time; non-live lanes get 0.
+// All N lanes of an 8-bit texture, W at a time; non-live lanes get 0. Only
+// the output components in `components` (bit k: r, g, b, a) are written, and
+// only the stored channels they need are read.
 template <int N, int W, int C>
-inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
     using V = Simd<W>;
     using F = typename V::F;
     bool divide[4];
     for (int c = 0; c < C; ++c) divide[c] = tex.table(c) == unorm8_decode_table();
     float* dst[4] = {out.r, out.g, out.b, out.a};
+    unsigned need = 0;
+    for (int k = 0; k < 4; ++k)
+        if (((components >> k) & 1u) && tex.swizzle(k) != Texture::kOne) need |= 1u << tex.swizzle(k);
     for (int l0 = 0; l0 < N; l0 += W) {
         const unsigned live = (at.live >> l0) & ((1u << W) - 1u);
         if (!live) {
-            for (int k = 0; k < 4; ++k) V::store_f(dst[k] + l0, V::zero_f());
+            for (int k = 0; k < 4; ++k)
+                if ((components >> k) & 1u) V::store_f(dst[k] + l0, V::zero_f());
             continue;
         }
-        F res[4];
-        bilinear_unorm8<V, C>(tex, divide, at.ia, at.txa, at.tya, l0, res);
+        F res[4] = {V::zero_f(), V::zero_f(), V::zero_f(), V::zero_f()};
+        bilinear_unorm8<V, C>(tex, divide, need, at.ia, at.txa, at.tya, l0, res);
         const unsigned blend = (at.blend >> l0) & ((1u << W) - 1u);
         if (blend) {
-            F resb[4];
-            bilinear_unorm8<V, C>(tex, divide, at.ib, at.txb, at.tyb, l0, resb);
+            F resb[4] = {V::zero_f(), V::zero_f(), V::zero_f(), V::zero_f()};
+            bilinear_unorm8<V, C>(tex, divide, need, at.ib, at.txb, at.tyb, l0, resb);
             const F t = V::load_f(at.t + l0);
             const F mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits()));
-            for (int c = 0; c < C; ++c) res[c] = V::select(mask, V::add(res[c], V::mul(V::sub(resb[c], res[c]), t)), res[c]);
+            for (int c = 0; c < C; ++c)
+                if ((need >> c) & 1u) res[c] = V::select(mask, V::add(res[c], V::mul(V::sub(resb[c], res[c]), t)), res[c]);
         }
         const F live_mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(live)), V::lane_bits()), V::lane_bits()));
         const F zero = V::zero_f();
         for (int k = 0; k < 4; ++k) {
+            if (!((components >> k) & 1u)) continue;
             const int sw = tex.swizzle(k);
             const F v = sw == Texture::kOne ? V::set1_f(1.0f) : res[sw];
             V::store_f(dst[k] + l0, V::select(live_mask, v, zero));
@@ -365,14 +374,14 @@ inline void fetch_unorm8_one_by_one(const Texture& tex, const TrilinearLanes& at
 constexpr int kSparseLanes = 4;
 
 template <int N>
-inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
     constexpr int W = N >= 8 ? 8 : 4;
     const bool sparse = __builtin_popcount(at.live) <= kSparseLanes;
     switch (tex.channels()) {
-    case 1: sparse ? fetch_unorm8_one_by_one<N, 1>(tex, at, out) : fetch_unorm8_lanes<N, W, 1>(tex, at, out); return;
-    case 2: sparse ? fetch_unorm8_one_by_one<N, 2>(tex, at, out) : fetch_unorm8_lanes<N, W, 2>(tex, at, out); return;
-    case 3: sparse ? fetch_unorm8_one_by_one<N, 3>(tex, at, out) : fetch_unorm8_lanes<N, W, 3>(tex, at, out); return;
-    default: sparse ? fetch_unorm8_one_by_one<N, 4>(tex, at, out) : fetch_unorm8_lanes<N, W, 4>(tex, at, out); return;
+    case 1: sparse ? fetch_unorm8_one_by_one<N, 1>(tex, at, out) : fetch_unorm8_lanes<N, W, 1>(tex, at, out, components); return;
+    case 2: sparse ? fetch_unorm8_one_by_one<N, 2>(tex, at, out) : fetch_unorm8_lanes<N, W, 2>(tex, at, out, components); return;
+    case 3: sparse ? fetch_unorm8_one_by_one<N, 3>(tex, at, out) : fetch_unorm8_lanes<N, W, 3>(tex, at, out, components); return;
+    default: sparse ? fetch_unorm8_one_by_one<N, 4>(tex, at, out) : fetch_unorm8_lanes<N, W, 4>(tex, at, out, components); return;
     }
 }
 
@@ -474,9 +483,11 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
 // first N are set to 0. 8-bit textures go through the gathers (AVX2 builds);
 // float ones are read lane by lane, up to three per pass so that the indices
 // and weights are read once and the texel loads of the textures overlap.
+// components[k] (bit 0 r, 1 g, 2 b, 3 a; null: all) says which components of
+// out[k] the caller reads: the gathers skip the others (left unwritten).
 template <int N = kBlockLanes>
 inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const TrilinearLanes& at,
-                                  TexelLanes* const* out) {
+                                  TexelLanes* const* out, const std::uint8_t* components = nullptr) {
     using namespace sample_lanes_detail;
 #ifdef __AVX2__
     const Texture* rest[3];
@@ -484,7 +495,7 @@ inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const Tr
     int n_rest = 0;
     for (int k = 0; k < count; ++k) {
         if (tex[k]->is_unorm8()) {
-            fetch_unorm8_lanes<N>(*tex[k], at, *out[k]);
+            fetch_unorm8_lanes<N>(*tex[k], at, *out[k], components ? components[k] : 0xFu);
             continue;
         }
         rest[n_rest] = tex[k];
@@ -496,6 +507,7 @@ inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const Tr
     }
     fetch_lanes_one_by_one<N>(rest, n_rest, at, rest_out);
 #else
+    (void)components;
     fetch_lanes_one_by_one<N>(tex, count, at, out);
 #endif
 }
