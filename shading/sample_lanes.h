@@ -129,30 +129,34 @@ inline void prepare_s(Wrap t, const float* u, const float* v, const LevelLanes& 
 // 4-channel float vector (one texel); lane-wise IEEE operations, no contraction.
 typedef float Float4 __attribute__((vector_size(16)));
 
-// One texel of the chain as a 4-channel vector, whatever the storage.
-inline Float4 load_texel(const Texture& tex, std::int32_t i) {
+// A float texture's texel as a 4-channel vector.
+inline Float4 load_texel(const glm::vec4* texels, std::int32_t i) {
     Float4 r;
-    if (!tex.is_unorm8()) {
-        std::memcpy(&r, &tex.texel_data()[i], sizeof r);
-    } else {
-        const glm::vec4 t = tex.texel_at(std::size_t(i));
-        r = Float4{t.r, t.g, t.b, t.a};
-    }
+    std::memcpy(&r, &texels[i], sizeof r);
     return r;
 }
 
-inline Float4 bilinear(const Texture& tex, const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty,
-                       int l) {
-    const Float4 a = load_texel(tex, idx[0][l]), b = load_texel(tex, idx[1][l]);
-    const Float4 c = load_texel(tex, idx[2][l]), d = load_texel(tex, idx[3][l]);
+// Any storage (the non-AVX2 builds' path for 8-bit textures).
+inline Float4 load_texel(const Texture* tex, std::int32_t i) {
+    if (!tex->is_unorm8()) return load_texel(tex->texel_data(), i);
+    const glm::vec4 t = tex->texel_at(std::size_t(i));
+    return Float4{t.r, t.g, t.b, t.a};
+}
+
+template <class Texels>
+[[gnu::always_inline]] inline Float4 bilinear(const Texels& texels, const std::int32_t (*idx)[kMaxN], const float* tx,
+                                              const float* ty, int l) {
+    const Float4 a = load_texel(texels, idx[0][l]), b = load_texel(texels, idx[1][l]);
+    const Float4 c = load_texel(texels, idx[2][l]), d = load_texel(texels, idx[3][l]);
     const Float4 top = a + (b - a) * tx[l];
     const Float4 bottom = c + (d - c) * tx[l];
     return top + (bottom - top) * ty[l];
 }
 
-// The live lanes one at a time, for K textures of any storage.
-template <int N, int K>
-inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLanes& at, TexelLanes* const* out) {
+// The live lanes one at a time, for K textures: src[k] is a float texture's
+// texel array, or the Texture itself (any storage).
+template <int N, int K, class Texels>
+inline void fetch_lanes_one_by_one(const Texels* const* src, const TrilinearLanes& at, TexelLanes* const* out) {
     if (at.live != (1u << N) - 1u) {
         for (int k = 0; k < K; ++k)
             for (int l = 0; l < N; ++l) out[k]->r[l] = out[k]->g[l] = out[k]->b[l] = out[k]->a[l] = 0.0f;
@@ -160,10 +164,10 @@ inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLan
     for (std::uint32_t m = at.live; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         Float4 c[K];
-        for (int k = 0; k < K; ++k) c[k] = bilinear(*tex[k], at.ia, at.txa, at.tya, l);
+        for (int k = 0; k < K; ++k) c[k] = bilinear(src[k], at.ia, at.txa, at.tya, l);
         if ((at.blend >> l) & 1u) {
             for (int k = 0; k < K; ++k) {
-                const Float4 cb = bilinear(*tex[k], at.ib, at.txb, at.tyb, l);
+                const Float4 cb = bilinear(src[k], at.ib, at.txb, at.tyb, l);
                 c[k] = c[k] + (cb - c[k]) * at.t[l];
             }
         }
@@ -173,6 +177,19 @@ inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLan
             out[k]->b[l] = c[k][2];
             out[k]->a[l] = c[k][3];
         }
+    }
+}
+
+template <int N, int K>
+inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLanes& at, TexelLanes* const* out) {
+    bool float_only = true;
+    for (int k = 0; k < K; ++k) float_only &= !tex[k]->is_unorm8();
+    if (float_only) {
+        const glm::vec4* texels[K];
+        for (int k = 0; k < K; ++k) texels[k] = tex[k]->texel_data();
+        fetch_lanes_one_by_one<N, K, glm::vec4>(texels, at, out);
+    } else {
+        fetch_lanes_one_by_one<N, K, Texture>(tex, at, out);
     }
 }
 
@@ -262,7 +279,7 @@ inline typename V::F decode_channel(typename V::I words, int c, const float* tab
 
 // Bilinear filter of every stored channel of one level for lanes [l0, l0 + W).
 template <class V, int C>
-inline void bilinear_unorm8(const Texture& tex, const bool* divide, unsigned need, const std::int32_t (*idx)[kMaxN],
+[[gnu::always_inline]] inline void bilinear_unorm8(const Texture& tex, const bool* divide, unsigned need, const std::int32_t (*idx)[kMaxN],
                             const float* tx_lanes, const float* ty_lanes, int l0, typename V::F* result) {
     using F = typename V::F;
     const std::uint8_t* base = tex.unorm8_data();
@@ -328,7 +345,7 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
 // The stored channels of one 8-bit texel (index i) as a vector, through
 // their tables; channels past C are 0 (never written out).
 template <int C>
-inline Float4 load_unorm8_texel(const std::uint8_t* base, const float* const* table, std::int32_t i) {
+[[gnu::always_inline]] inline Float4 load_unorm8_texel(const std::uint8_t* base, const float* const* table, std::int32_t i) {
     const std::uint8_t* p = base + std::size_t(i) * C;
     Float4 r = {0.0f, 0.0f, 0.0f, 0.0f};
     r[0] = table[0][p[0]];
@@ -339,7 +356,7 @@ inline Float4 load_unorm8_texel(const std::uint8_t* base, const float* const* ta
 }
 
 template <int C>
-inline Float4 bilinear_unorm8_lane(const std::uint8_t* base, const float* const* table,
+[[gnu::always_inline]] inline Float4 bilinear_unorm8_lane(const std::uint8_t* base, const float* const* table,
                                    const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty, int l) {
     const Float4 a = load_unorm8_texel<C>(base, table, idx[0][l]), b = load_unorm8_texel<C>(base, table, idx[1][l]);
     const Float4 c = load_unorm8_texel<C>(base, table, idx[2][l]), d = load_unorm8_texel<C>(base, table, idx[3][l]);
