@@ -97,6 +97,7 @@ public:
         b.by = std::uint16_t(by);
         b.mask = std::uint16_t(mask);
         b.pass = std::uint16_t(pass);
+        b.shaded = 0;
         b.live = 0;
         b.z = std::uint32_t(t.z.size());
         for (std::uint32_t m = mask & 0xFFFFu; m; m &= m - 1) t.z.push_back(z[__builtin_ctz(m)]);
@@ -113,6 +114,7 @@ public:
         for (std::size_t i = blocks.size(); i-- > 0;) {
             BlockRecord& b = blocks[i];
             if (b.bx == in.x && b.by == in.y && b.piece == tri) {
+                b.shaded = std::uint16_t(in.mask);
                 b.live = std::uint16_t(live);
                 return;
             }

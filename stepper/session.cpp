@@ -91,8 +91,17 @@ public:
 
     template <int NV>
     void shaded(const FragmentBlock<NV>& in, const FragmentOut& out, std::uint32_t live) {
+        // The recorded block of this (block, triangle): shading may come
+        // right after fragments() or later in the tile (visibility pass).
         const std::size_t tile = std::size_t(rec_.tile_of(in.x, in.y));
-        const BlockRecord& b = rec_.tiles[tile].blocks[cursor_[tile] - 1];
+        const std::vector<BlockRecord>& blocks = rec_.tiles[tile].blocks;
+        const std::uint32_t tri = rec_.draws[std::size_t(draw_ - 1)].first_triangle + in.prim_id;
+        std::size_t i = cursor_[tile];
+        while (i > 0 && !(blocks[i - 1].bx == in.x && blocks[i - 1].by == in.y &&
+                          rec_.pieces[blocks[i - 1].piece].triangle == tri))
+            --i;
+        if (i == 0) return fail("a shaded block the recording does not have");
+        const BlockRecord& b = blocks[i - 1];
         ReplayedBlock rb;
         replay_block(s_, rec_, b, rb);
         ++shaded_blocks_;
