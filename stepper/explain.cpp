@@ -453,15 +453,14 @@ PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, 
         h.depth_before = depth;
         h.color_before = color;
         h.passed = (b.pass >> lane) & 1u;
+        h.shaded = (b.shaded >> lane) & 1u;
         h.written = (b.live >> lane) & 1u;
-        h.killed = h.passed && !h.written;
+        h.killed = h.shaded && !h.written;
         replay_block(s, rec, b, h.replay);
         if (h.passed) {
             h.shading = shade_lane(ctx, material_of(s, rec, rec.pieces[b.piece].triangle), h.replay, lane);
-            if (h.written) {
-                depth = h.z;  // every draw of the frame writes depth
-                color = h.shading.Lo;
-            }
+            if (!h.killed) depth = h.z;  // every draw of the frame writes depth
+            if (h.written) color = h.shading.Lo;
         }
         h.color_after = color;
         px.history.push_back(std::move(h));
@@ -581,7 +580,9 @@ std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExpl
             continue;
         }
         o << "passed; ";
-        if (h.killed)
+        if (!h.shaded)
+            o << "not shaded: a later fragment won the pixel (the visibility pass shades winners only)\n";
+        else if (h.killed)
             o << "discarded by the shader (alpha " << num(h.shading.ms.alpha) << " below the cutoff)\n";
         else
             o << "shader out " << vec(h.shading.Lo) << ", colour " << vec(h.color_before) << " -> "
@@ -614,8 +615,9 @@ json pixel_json(const StepScene& s, const Recording& rec, const PixelExplanation
         e["tri"] = rec.pieces[h.piece].triangle;
         e["mesh"] = mesh_name(s, rec, rec.pieces[h.piece].triangle);
         e["depth"] = h.z;
-        e["result"] = !h.passed ? "depth test failed" : h.killed ? "discarded" : "written";
-        if (h.passed && !h.killed) e["out"] = j3(h.shading.Lo);
+        e["result"] = !h.passed ? "depth test failed" : !h.shaded ? "passed, not shaded (a later one won)"
+                      : h.killed ? "discarded" : "written";
+        if (h.written) e["out"] = j3(h.shading.Lo);
         hist.push_back(e);
     }
     j["history"] = hist;

@@ -38,7 +38,9 @@ struct HistoryEntry {
     float z = 0.0f;               // the fragment's depth (recorded)
     float depth_before = 1.0f;    // the buffer's depth when it was tested
     glm::vec3 color_before{0.0f}, color_after{0.0f};
-    bool passed = false, written = false, killed = false;
+    bool passed = false;          // passed the depth test (then wrote its depth)
+    bool shaded = false;          // the fragment program ran for it
+    bool written = false, killed = false;  // its colour was written / it was discarded
     ReplayedBlock replay;
     LaneShading shading;          // only when it passed the depth test (the shader ran)
 };

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "raster/pipeline.h"
 #include "shading/pbr_program.h"
@@ -34,12 +35,15 @@ inline ShadingContext shading_context(const FrameSettings& s) {
     return ctx;
 }
 
-// An observer that also hears which draw comes next.
-//   void begin_draw(int mesh, std::uint32_t first_triangle, std::uint32_t triangles,
-//                   std::uint32_t vertices, const DrawState&);
-template <class Observer>
-void draw_frame(StepScene& s, Framebuffer& fb, Observer& obs,
+// make_tap(mesh, first_triangle, triangles, vertices, state) gives the
+// observer of each draw (raster/observer.h), created before the draw runs;
+// the taps live until the frame is done.
+template <class MakeTap>
+void draw_frame(StepScene& s, Framebuffer& fb, MakeTap&& make_tap,
                 std::uint64_t triangle_limit = std::numeric_limits<std::uint64_t>::max()) {
+    using Tap = decltype(make_tap(0, 0u, 0u, 0u, DrawState{}));
+    std::vector<Tap> taps;
+    taps.reserve(s.scene.meshes.size());
     Renderer& renderer = *s.renderer;
     renderer.clear(fb, 0.0f, 0.0f, 0.0f, 1.0f);
     renderer.begin_frame();
@@ -64,11 +68,10 @@ void draw_frame(StepScene& s, Framebuffer& fb, Observer& obs,
         const std::uint64_t triangles = mesh.indices.size() / 3;
         if (first >= triangle_limit) break;
         const std::uint64_t drawn = std::min<std::uint64_t>(triangles, triangle_limit - first);
-        if constexpr (Observer::enabled)
-            obs.begin_draw(int(m), std::uint32_t(first), std::uint32_t(triangles),
-                           std::uint32_t(mesh.positions.size()), st);
+        taps.push_back(make_tap(int(m), std::uint32_t(first), std::uint32_t(triangles),
+                                std::uint32_t(mesh.positions.size()), st));
         renderer.draw(fb, prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(),
-                      std::size_t(drawn) * 3, st, obs);
+                      std::size_t(drawn) * 3, st, taps.back());
         first += triangles;
     }
 }

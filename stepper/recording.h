@@ -58,11 +58,14 @@ struct TriangleRecord {
 };
 
 // One 4x4 block of one triangle piece in a tile: covered, passed the depth
-// test, written (passed and not discarded by the shader).
+// test (at that point of the tile's sequence), shaded (the lanes the
+// fragment program ran for: all that passed when shaded in order, only the
+// final winners when shaded after a visibility pass) and written (shaded
+// and not discarded).
 struct BlockRecord {
     std::uint32_t piece = 0;            // index into Recording::pieces
     std::uint16_t bx = 0, by = 0;       // top-left pixel
-    std::uint16_t mask = 0, pass = 0, live = 0;
+    std::uint16_t mask = 0, pass = 0, shaded = 0, live = 0;
     std::uint32_t z = 0;                // first covered lane's depth in TileRecord::z (lane order)
 };
 

@@ -106,7 +106,7 @@ void replay_block(const StepScene& s, const Recording& rec, const BlockRecord& b
     }
     in.x = b.bx;
     in.y = b.by;
-    in.mask = b.pass;
+    in.mask = b.shaded ? b.shaded : b.pass;  // the lanes the shader ran for
     in.prim_id = t.prim_id;
     in.front_facing = t.front_facing;
 }

@@ -59,29 +59,42 @@ std::string count_range(long n) { return n > 0 ? "0.." + std::to_string(n - 1) :
 // same order, and the values the stepper recomputes equal to the pipeline's.
 class VerifyObserver {
 public:
-    static constexpr bool enabled = true;
-
     VerifyObserver(const StepScene& s, const Recording& rec)
         : s_(s), rec_(rec), ctx_(shading_context(s.settings)), cursor_(rec.tiles.size(), 0) {}
 
-    void begin_draw(int, std::uint32_t, std::uint32_t, std::uint32_t, const DrawState&) { ++draw_; }
+    // The observer of one draw.
+    struct Tap {
+        static constexpr bool enabled = true;
+        VerifyObserver* v;
+        std::size_t draw;
+        void vertex(std::uint32_t i, const float* clip, const float* var, int nv) { v->vertex(draw, i, clip, var, nv); }
+        void triangle(std::uint32_t, TriangleFate, bool, const TriangleSetup*) {}
+        void binned(std::uint32_t, int) {}
+        void fragments(std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass, const float* z) {
+            v->fragments(draw, prim, bx, by, mask, pass, z);
+        }
+        template <int NV>
+        void shaded(const FragmentBlock<NV>& in, const FragmentOut& out, std::uint32_t live) {
+            v->shaded(draw, in, out, live);
+        }
+    };
+    Tap tap() { return Tap{this, draws_++}; }
 
-    void vertex(std::uint32_t v, const float* clip, const float* var, int nv) {
-        const float* r = &rec_.draws[std::size_t(draw_ - 1)].vertices[std::size_t(v) * kStride];
+    void vertex(std::size_t draw, std::uint32_t v, const float* clip, const float* var, int nv) {
+        const float* r = &rec_.draws[draw].vertices[std::size_t(v) * kStride];
         ++vertices_;
         if (std::memcmp(r, clip, 4 * sizeof(float)) || std::memcmp(r + 4, var, std::size_t(nv) * sizeof(float)))
-            fail("vertex " + std::to_string(v) + " of draw " + std::to_string(draw_ - 1) + " differs");
+            fail("vertex " + std::to_string(v) + " of draw " + std::to_string(draw) + " differs");
     }
-    void triangle(std::uint32_t, TriangleFate, bool, const TriangleSetup*) {}
-    void binned(std::uint32_t, int) {}
 
-    void fragments(std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass, const float* z) {
+    void fragments(std::size_t draw, std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass,
+                   const float* z) {
         const std::size_t tile = std::size_t(rec_.tile_of(bx, by));
         const TileRecord& t = rec_.tiles[tile];
         ++blocks_;
         if (cursor_[tile] >= t.blocks.size()) return fail("tile " + std::to_string(tile) + " has more blocks");
         const BlockRecord& b = t.blocks[cursor_[tile]++];
-        const std::uint32_t tri = rec_.draws[std::size_t(draw_ - 1)].first_triangle + prim;
+        const std::uint32_t tri = rec_.draws[draw].first_triangle + prim;
         bool same = b.bx == bx && b.by == by && b.mask == mask && b.pass == pass && rec_.pieces[b.piece].triangle == tri;
         std::size_t k = b.z;
         for (std::uint32_t m = mask; m && same; m &= m - 1) same = t.z[k++] == z[__builtin_ctz(m)];
@@ -90,9 +103,18 @@ public:
     }
 
     template <int NV>
-    void shaded(const FragmentBlock<NV>& in, const FragmentOut& out, std::uint32_t live) {
+    void shaded(std::size_t draw, const FragmentBlock<NV>& in, const FragmentOut& out, std::uint32_t live) {
+        // The recorded block of this (block, triangle): shading may come
+        // right after fragments() or later in the tile (visibility pass).
         const std::size_t tile = std::size_t(rec_.tile_of(in.x, in.y));
-        const BlockRecord& b = rec_.tiles[tile].blocks[cursor_[tile] - 1];
+        const std::vector<BlockRecord>& blocks = rec_.tiles[tile].blocks;
+        const std::uint32_t tri = rec_.draws[draw].first_triangle + in.prim_id;
+        std::size_t i = cursor_[tile];
+        while (i > 0 && !(blocks[i - 1].bx == in.x && blocks[i - 1].by == in.y &&
+                          rec_.pieces[blocks[i - 1].piece].triangle == tri))
+            --i;
+        if (i == 0) return fail("a shaded block the recording does not have");
+        const BlockRecord& b = blocks[i - 1];
         ReplayedBlock rb;
         replay_block(s_, rec_, b, rb);
         ++shaded_blocks_;
@@ -123,7 +145,7 @@ public:
     const Recording& rec_;
     const ShadingContext ctx_;
     std::vector<std::size_t> cursor_;
-    int draw_ = 0;
+    std::size_t draws_ = 0;
     std::atomic<std::uint64_t> vertices_{0}, blocks_{0}, shaded_blocks_{0}, pixels_{0};
     std::mutex mutex_;
     std::uint64_t failures_ = 0;
@@ -267,7 +289,7 @@ std::vector<std::uint8_t> Session::upto_png(std::uint64_t triangles) {
 Reply Session::verify() {
     VerifyObserver obs(s_, rec_);
     Framebuffer fb(rec_.width, rec_.height);
-    draw_frame(s_, fb, obs);
+    draw_frame(s_, fb, [&](int, std::uint32_t, std::uint32_t, std::uint32_t, const DrawState&) { return obs.tap(); });
     for (std::size_t t = 0; t < rec_.tiles.size(); ++t)
         if (obs.cursor_[t] != rec_.tiles[t].blocks.size()) obs.fail("tile " + std::to_string(t) + " has fewer blocks");
     if (std::memcmp(fb.color.data(), rec_.fb.color.data(), fb.color.size() * sizeof(float)) ||

@@ -221,7 +221,7 @@ void draw_counts(const Recording& rec, Image& img, bool quads) {
             if (quads) {
                 m = 0;
                 for (int q = 0; q < 4; ++q)
-                    if ((b.pass >> (4 * q)) & 0xFu) m |= 0xFu << (4 * q);
+                    if ((b.shaded >> (4 * q)) & 0xFu) m |= 0xFu << (4 * q);
             }
             for (; m; m &= m - 1) {
                 const int l = __builtin_ctz(m);
