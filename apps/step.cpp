@@ -121,9 +121,28 @@ int run(int argc, char** argv) {
         return kExitUsage;
     }
 
+    FrameRequest req;
+    req.scene = opt.scene;
+    req.width = opt.width;
+    req.height = opt.height;
+    req.eye = opt.eye;
+    req.target = opt.target;
+    req.up = opt.up;
+    req.fov_deg = opt.fov_deg;
+    req.near_plane = opt.near_plane;
+    req.far_plane = opt.far_plane;
+    req.lights = opt.lights;
+    req.ambient = opt.ambient;
+    req.no_default_lights = opt.no_default_lights;
+    req.brdf = opt.brdf;
+    req.exposure = opt.exposure;
+    req.tonemap = opt.effective_tonemap();
+    req.threads = opt.threads;
+    req.tile_size = opt.tile_size;
+
     StepScene scene;
     SetupError setup_err;
-    if (!setup_scene(opt, scene, setup_err)) {
+    if (!setup_scene(req, scene, setup_err)) {
         std::fprintf(stderr, "step: %s\n", setup_err.message.c_str());
         return setup_err.code;
     }

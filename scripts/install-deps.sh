@@ -4,7 +4,20 @@
 set -e
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-PACKAGES="build-essential cmake libglm-dev libtinyobjloader-dev libstb-dev doctest-dev libtinygltf-dev nlohmann-json3-dev zlib1g-dev libpng-dev libcpp-httplib-dev pkg-config"
+PACKAGES="
+  build-essential
+  cmake
+  libglm-dev
+  libtinyobjloader-dev
+  libstb-dev
+  doctest-dev
+  libtinygltf-dev
+  nlohmann-json3-dev
+  zlib1g-dev
+  libpng-dev
+  libcpp-httplib-dev
+  pkg-config
+"
 missing=""
 for p in $PACKAGES; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <sstream>
+#include <unordered_map>
 
 #include "shading/color.h"
 #include "shading/tonemap.h"
@@ -393,17 +394,22 @@ std::string tile_text(const StepScene& s, const Recording& rec, int tx, int ty) 
     o << "tile " << tx << " " << ty << ": pixels x " << x0 << ".." << std::min(x0 + rec.tile_size, rec.width) - 1
       << " y " << y0 << ".." << std::min(y0 + rec.tile_size, rec.height) - 1 << ", " << t.pieces.size()
       << " bin entries, " << t.blocks.size() << " blocks, in the order the tile ran them:\n";
+    // Blocks of each piece, in one pass over the tile's blocks.
+    struct Counts { int blocks = 0, covered = 0, passed = 0, written = 0; };
+    std::unordered_map<std::uint32_t, Counts> counts;
+    for (const BlockRecord& b : t.blocks) {
+        Counts& c = counts[b.piece];
+        ++c.blocks;
+        c.covered += __builtin_popcount(b.mask);
+        c.passed += __builtin_popcount(b.pass);
+        c.written += __builtin_popcount(b.live);
+    }
     for (std::uint32_t pi : t.pieces) {
         const PieceRecord& p = rec.pieces[pi];
         const TriangleRecord& tr = rec.triangles[p.triangle];
-        int blocks = 0, covered = 0, passed = 0, written = 0;
-        for (const BlockRecord& b : t.blocks) {
-            if (b.piece != pi) continue;
-            ++blocks;
-            covered += __builtin_popcount(b.mask);
-            passed += __builtin_popcount(b.pass);
-            written += __builtin_popcount(b.live);
-        }
+        const auto it = counts.find(pi);
+        const Counts c = it == counts.end() ? Counts{} : it->second;
+        const int blocks = c.blocks, covered = c.covered, passed = c.passed, written = c.written;
         o << "  tri " << p.triangle;
         if (tr.piece_count > 1) o << " piece " << (pi - tr.first_piece);
         o << " (" << quoted(mesh_name(s, rec, p.triangle)) << "): " << blocks << " blocks, " << covered

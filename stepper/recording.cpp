@@ -105,8 +105,18 @@ public:
 
     template <int NV>
     void shaded(const FragmentBlock<NV>& in, const FragmentOut&, std::uint32_t live) {
-        // Called right after fragments() for the same block, on the same thread.
-        rec_.tiles[std::size_t(rec_.tile_of(in.x, in.y))].blocks.back().live = std::uint16_t(live);
+        // The tile's thread calls this after fragments() for the same block:
+        // today right after it; searched from the back so that a pipeline
+        // shading later in the tile is recorded as well.
+        std::vector<BlockRecord>& blocks = rec_.tiles[std::size_t(rec_.tile_of(in.x, in.y))].blocks;
+        const std::uint32_t tri = rec_.draws.back().first_triangle + in.prim_id;
+        for (std::size_t i = blocks.size(); i-- > 0;) {
+            BlockRecord& b = blocks[i];
+            if (b.bx == in.x && b.by == in.y && b.piece == tri) {
+                b.live = std::uint16_t(live);
+                return;
+            }
+        }
     }
 
     // Turns the draw's events into triangles, pieces and bins, and names the

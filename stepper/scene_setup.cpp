@@ -23,7 +23,7 @@ glm::vec3 rotate_around(const glm::vec3& v, const glm::vec3& k, double radians) 
 
 } // namespace
 
-bool setup_scene(const RenderOptions& opt, StepScene& out, SetupError& err) {
+bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     out.options = opt;
     Camera camera;
     if (opt.scene.empty()) {

@@ -5,19 +5,40 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include "apps/render_options.h"
+#include <glm/glm.hpp>
+
 #include "raster/pipeline.h"
 #include "scene/scene.h"
 #include "shading/scene_renderer.h"
+#include "shading/tonemap.h"
 
 namespace prast::stepper {
 
+// The frame to record: what render's options (apps/render_options.h) say
+// about the scene, camera, lights and view transform; apps/step.cpp fills it.
+struct FrameRequest {
+    std::string scene;                       // empty: the built-in scene
+    int width = 1280, height = 720;
+    std::optional<glm::vec3> eye, target, up;
+    float fov_deg = 45.0f;
+    std::optional<float> near_plane, far_plane;
+    std::vector<ShadingLight> lights;        // from the flags, in order
+    glm::vec3 ambient{0.03f};
+    bool no_default_lights = false;
+    BrdfModel brdf = BrdfModel::Default;
+    float exposure = 1.0f;
+    ToneMap tonemap = ToneMap::Aces;         // render's effective tone map
+    int threads = 0;
+    int tile_size = kDefaultTileSize;
+};
+
 // A scene ready to draw: loaded, framed, lit, its textures bound.
 struct StepScene {
-    RenderOptions options;
+    FrameRequest options;
     Scene scene;
     FrameSettings settings;          // camera (frame 0), lights, ambient, BRDF
     std::unique_ptr<Renderer> renderer;
@@ -26,7 +47,7 @@ struct StepScene {
     int width() const { return options.width; }
     int height() const { return options.height; }
     float exposure() const { return options.exposure; }
-    ToneMap tonemap() const { return options.effective_tonemap(); }
+    ToneMap tonemap() const { return options.tonemap; }
 };
 
 // What went wrong while setting up: a message and render's exit code
@@ -37,6 +58,6 @@ struct SetupError {
 };
 
 // Loads and frames as render does; returns false with `err` set on failure.
-bool setup_scene(const RenderOptions& options, StepScene& out, SetupError& err);
+bool setup_scene(const FrameRequest& request, StepScene& out, SetupError& err);
 
 } // namespace prast::stepper

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <sstream>
@@ -34,8 +35,16 @@ std::vector<std::string> split_words(const std::string& line) {
 }
 
 bool parse_int(const std::string& word, long lo, long hi, long& out) {
-    long v;
-    if (word.size() > 18 || !render_cli::parse_integer(word, v) || v < lo || v > hi) return false;
+    // Digits only (an optional '-'), at most 18 of them: no overflow, no "1e3", no "0x10".
+    std::size_t i = word.size() > 1 && word[0] == '-' ? 1 : 0;
+    if (word.empty() || word.size() - i > 18 || i == word.size()) return false;
+    long v = 0;
+    for (; i < word.size(); ++i) {
+        if (word[i] < '0' || word[i] > '9') return false;
+        v = v * 10 + (word[i] - '0');
+    }
+    if (word[0] == '-') v = -v;
+    if (v < lo || v > hi) return false;
     out = v;
     return true;
 }

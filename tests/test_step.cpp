@@ -222,6 +222,47 @@ TEST_CASE("upto: all triangles give render's image, none the cleared frame") {
     CHECK(half.rgb != want.rgb);
 }
 
+TEST_CASE("--out: every stage as a PNG and an index.html; the final stage is render's image") {
+    CliSandbox box;
+    REQUIRE(box.run_exe(kRender, {"--size", "320x180", "-o", "r.png"}).code == 0);
+    const CliRun r = box.run_exe(kStep, {"--size", "320x180", "--out", "stages"});
+    REQUIRE(r.code == 0);
+    const std::string index = read_text(box.work() / "stages" / "index.html");
+    const char* kStages[] = {"vertices", "wireframe", "bins", "depth", "overdraw", "quad_overdraw", "triangle_size",
+                             "nan", "albedo", "normal", "roughness", "metallic", "occlusion", "mip", "D", "F", "G",
+                             "diffuse", "specular", "final"};
+    for (const char* name : kStages) {
+        INFO(name);
+        const Rgb8 img = load_rgb8(box.path(std::string("stages/") + name + ".png"));
+        CHECK(img.width == 320);
+        CHECK(img.height == 180);
+        CHECK(index.find(std::string("src=\"") + name + ".png\"") != std::string::npos);
+    }
+    CHECK(index.find("http") == std::string::npos);  // nothing to fetch: opens offline
+    const Rgb8 want = load_rgb8(box.path("r.png")), final = load_rgb8(box.path("stages/final.png"));
+    CHECK(final.rgb == want.rgb);
+    // No NaN, infinity or negative value in the built-in frame: all grey.
+    const Rgb8 nan = load_rgb8(box.path("stages/nan.png"));
+    for (std::size_t i = 0; i < nan.rgb.size(); ++i) REQUIRE(nan.rgb[i] == 64);
+    // Depth and albedo are black exactly where render drew the background.
+    const Rgb8 depth = load_rgb8(box.path("stages/depth.png")), albedo = load_rgb8(box.path("stages/albedo.png"));
+    int background = 0;
+    for (int y = 0; y < 180; ++y)
+        for (int x = 0; x < 320; ++x) {
+            const bool empty = want.at(x, y)[0] == 0 && want.at(x, y)[1] == 0 && want.at(x, y)[2] == 0;
+            background += empty;
+            if (empty) CHECK(albedo.at(x, y)[0] + albedo.at(x, y)[1] + albedo.at(x, y)[2] == 0);
+            else CHECK(albedo.at(x, y)[0] + albedo.at(x, y)[1] + albedo.at(x, y)[2] > 0);
+            if (empty) CHECK(depth.at(x, y)[0] == 0);
+        }
+    CHECK(background > 1000);
+    // A file where the directory should be: one line, exit 1.
+    write_text(box.work() / "afile", "x");
+    const CliRun bad = box.run_exe(kStep, {"--size", "32x18", "--out", "afile"});
+    CHECK(bad.code == 1);
+    CHECK(bad.err.find("afile") != std::string::npos);
+}
+
 TEST_CASE("sessions: the built-in scene, step by step") {
     check_transcript("builtin", {});
 }

@@ -8,18 +8,24 @@ front end (`step` with `pixel X Y` on standard input) prints for the same
 pixel; then a triangle from the pixel's history, the slider, and bad
 requests (4xx JSON, the server still answering afterwards).
 
-usage: test_step_page.py STEP_EXE
-Exit 77 (CTest: skipped) when chromium, chromedriver or python3-selenium is
-missing, unless PRAST_BROWSER_REQUIRED=1 (CI) makes that a failure.
+usage: test_step_page.py STEP_EXE [--api]
+With --api, no browser: the JSON API only (every endpoint, the pixel text
+against the terminal front end's, and a bounded loop of malformed requests
+that must all get 4xx JSON errors while the server keeps answering).
+Without it, exit 77 (CTest: skipped) when chromium, chromedriver or
+python3-selenium is missing, unless PRAST_BROWSER_REQUIRED=1 (CI) makes
+that a failure.
 """
 import json
 import os
+import random
 import shutil
 import subprocess
 import sys
 import tempfile
 import time
 import urllib.error
+import urllib.parse
 import urllib.request
 
 SKIP = 77
@@ -50,19 +56,86 @@ def step_text(step, commands):
 
 
 def get(url):
-    """(status, parsed JSON body) of a GET, 4xx included."""
+    """(status, parsed JSON body or None for an image) of a GET, 4xx included."""
     try:
-        with urllib.request.urlopen(url, timeout=30) as r:
-            return r.status, json.loads(r.read().decode())
+        with urllib.request.urlopen(url, timeout=60) as r:
+            body = r.read()
+            return r.status, json.loads(body.decode()) if "json" in r.headers["Content-Type"] else None
     except urllib.error.HTTPError as e:
         return e.code, json.loads(e.read().decode())
 
 
+def start_server(step):
+    server = subprocess.Popen([step] + FLAGS + ["--serve", "--port", "0"], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)
+    line = server.stdout.readline()
+    assert "serving http://127.0.0.1:" in line, "no URL from step --serve: " + line + server.stderr.read()
+    url = line.split("serving ")[1].split(" ")[0]
+    assert url.startswith("http://127.0.0.1:")
+    return server, url.rstrip("/")
+
+
+def stop_server(server):
+    server.terminate()
+    try:
+        server.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        server.kill()
+
+
+def api_checks(step):
+    server, base = start_server(step)
+    try:
+        code, frame = get(base + "/api/frame")
+        assert code == 200 and frame["width"] == 320 and frame["height"] == 180, frame
+        code, stages = get(base + "/api/stages")
+        assert code == 200 and "final" in [s["name"] for s in stages]
+        for x, y in ((100, 150), (0, 0), (319, 179), (160, 90)):
+            code, p = get(base + "/api/pixel?x=%d&y=%d" % (x, y))
+            assert code == 200 and p["text"] == step_text(step, "pixel %d %d\n" % (x, y)), (x, y)
+            assert p["text"].count("\nsrgb8 ") == 1
+        code, t = get(base + "/api/tri?n=98372")
+        assert code == 200 and t["text"] == step_text(step, "tri 98372\n")
+        code, t = get(base + "/api/tile?x=2&y=1")
+        assert code == 200 and t["text"] == step_text(step, "tile 2 1\n")
+        with urllib.request.urlopen(base + "/api/stage?name=final", timeout=60) as r:
+            assert r.headers["Content-Type"] == "image/png" and r.read(8) == b"\x89PNG\r\n\x1a\n"
+        # Malformed requests, a fixed list and a bounded, seeded random loop.
+        bad = [("/api/pixel?x=-1&y=0", 400), ("/api/pixel?x=320&y=0", 400), ("/api/pixel?x=1", 400),
+               ("/api/pixel?x=1e2&y=0", 400), ("/api/pixel?x=0x10&y=0", 400), ("/api/tri?n=abc", 400),
+               ("/api/tri?n=98432", 400), ("/api/tri?n=" + "9" * 40, 400), ("/api/tile?x=0", 400),
+               ("/api/tile?x=5&y=0", 400), ("/api/upto?n=-1", 400), ("/api/upto", 400),
+               ("/api/stage?name=nope", 404), ("/api/stage", 404), ("/nope", 404), ("/../../etc/passwd", 404),
+               ("/api/pixel?x=" + "9" * 9000, 414)]
+        rng = random.Random(10)
+        alphabet = "0123456789-+.e%&=?/xyn abc\u00e9"
+        for _ in range(150):
+            endpoint = rng.choice(["/api/pixel", "/api/tri", "/api/tile", "/api/upto", "/api/stage"])
+            query = "".join(rng.choice(alphabet) for _ in range(rng.randint(0, 30)))
+            bad.append((endpoint + "?" + urllib.parse.quote(query, safe="&=%"), None))
+        for path, status in bad:
+            code, body = get(base + path)
+            if status is None:
+                assert code in (200, 400, 404, 414) and (code == 200 or "error" in body), (path, code, body)
+            else:
+                assert code == status and "error" in body, (path, code, body)
+        code, frame = get(base + "/api/frame")
+        assert code == 200 and server.poll() is None
+        print("api: every endpoint answers as the terminal front end does; %d malformed requests got 4xx JSON"
+              % len(bad))
+    finally:
+        stop_server(server)
+
+
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) not in (2, 3) or (len(sys.argv) == 3 and sys.argv[2] != "--api"):
         print(__doc__)
         return 2
     step = sys.argv[1]
+    if len(sys.argv) == 3:
+        api_checks(step)
+        print("1 passed, 0 failed")
+        return 0
     browser = find_browser()
     driver_path = shutil.which("chromedriver")
     if not browser or not driver_path:
@@ -76,16 +149,11 @@ def main():
     except ImportError:
         skip("python3-selenium is not installed (apt-get install python3-selenium)")
 
-    server = subprocess.Popen([step] + FLAGS + ["--serve", "--port", "0"], stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True)
+    server, url = start_server(step)
+    url += "/"
     profile = tempfile.mkdtemp(prefix="prast_browser_")
     driver = None
     try:
-        line = server.stdout.readline()
-        assert "serving http://127.0.0.1:" in line, "no URL from step --serve: " + line + server.stderr.read()
-        url = line.split("serving ")[1].split(" ")[0]
-        assert url.startswith("http://127.0.0.1:")
-
         options = webdriver.ChromeOptions()
         options.binary_location = browser
         for flag in ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -146,11 +214,7 @@ def main():
     finally:
         if driver is not None:
             driver.quit()
-        server.terminate()
-        try:
-            server.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            server.kill()
+        stop_server(server)
         shutil.rmtree(profile, ignore_errors=True)
 
 
