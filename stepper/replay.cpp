@@ -74,6 +74,17 @@ SnappedVertex snap_vertex(const float* clip, int width, int height) {
     return v;
 }
 
+namespace {
+
+// The pixel the barycentric planes are anchored at: the setup's own anchor
+// (ax, ay) where TriangleSetup has one (multisampling), else the box corner.
+template <class T>
+auto plane_anchor(const T& t, int) -> decltype(t.ax, t.ay, glm::ivec2()) { return glm::ivec2(t.ax, t.ay); }
+template <class T>
+glm::ivec2 plane_anchor(const T& t, long) { return glm::ivec2(t.minx, t.miny); }
+
+} // namespace
+
 void replay_block(const StepScene& s, const Recording& rec, const BlockRecord& b, ReplayedBlock& out) {
     const PieceRecord& p = rec.pieces[b.piece];
     const TriangleSetup& t = rec.setups[p.setup];
@@ -87,7 +98,8 @@ void replay_block(const StepScene& s, const Recording& rec, const BlockRecord& b
         d2[k] = v[2][4 + k] - v[0][4 + k];
     }
     FragmentBlock<NV>& in = out.in;
-    const float ox = float(int(b.bx) - t.minx), oy = float(int(b.by) - t.miny);
+    const glm::ivec2 anchor = plane_anchor(t, 0);
+    const float ox = float(int(b.bx) - anchor.x), oy = float(int(b.by) - anchor.y);
     for (int l = 0; l < kBlockLanes; ++l) {
         // Screen-space barycentrics from the anchored planes, then depth.
         const float dx = ox + float(lane_x(l)), dy = oy + float(lane_y(l));

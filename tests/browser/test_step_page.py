@@ -76,11 +76,14 @@ def start_server(step):
 
 
 def stop_server(server):
+    """Stops the server; fails on anything a sanitizer build reported."""
     server.terminate()
     try:
-        server.wait(timeout=10)
+        _, err = server.communicate(timeout=30)
     except subprocess.TimeoutExpired:
         server.kill()
+        _, err = server.communicate()
+    assert "runtime error" not in err and "Sanitizer" not in err, err
 
 
 def api_checks(step):
