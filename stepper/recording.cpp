@@ -146,9 +146,11 @@ private:
         // shading later in the tile is recorded as well.
         std::vector<BlockRecord>& blocks = rec_.tiles[std::size_t(rec_.tile_of(x, y))].blocks;
         const std::uint32_t tri = rec_.draws[draw].first_triangle + prim;
+        // Two pieces of a clipped triangle may share a block: the one whose
+        // coverage holds the shaded lanes, not shaded yet.
         for (std::size_t i = blocks.size(); i-- > 0;) {
             BlockRecord& b = blocks[i];
-            if (b.bx == x && b.by == y && b.piece == tri) {
+            if (b.bx == x && b.by == y && b.piece == tri && b.shaded == 0 && (b.mask & in_mask) == in_mask) {
                 b.shaded = std::uint16_t(in_mask);
                 b.live = std::uint16_t(live);
                 return;

@@ -111,7 +111,7 @@ public:
         const std::uint32_t tri = rec_.draws[draw].first_triangle + in.prim_id;
         std::size_t i = cursor_[tile];
         while (i > 0 && !(blocks[i - 1].bx == in.x && blocks[i - 1].by == in.y &&
-                          rec_.pieces[blocks[i - 1].piece].triangle == tri))
+                          rec_.pieces[blocks[i - 1].piece].triangle == tri && blocks[i - 1].shaded == in.mask))
             --i;
         if (i == 0) return fail("a shaded block the recording does not have");
         const BlockRecord& b = blocks[i - 1];
