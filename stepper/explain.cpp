@@ -754,9 +754,15 @@ json pixel_json(const StepScene& s, const Recording& rec, const PixelExplanation
         e["owner"] = px.sample_owner[k];
         e["depth"] = px.sample_depth[k];
         e["color"] = j3(px.sample_color[k]);
+        // The sample alone through exposure, tone map and sRGB, to show it.
+        const float rgba[4] = {px.sample_color[k].r, px.sample_color[k].g, px.sample_color[k].b, 1.0f};
+        std::uint8_t srgb[4];
+        resolve_to_srgb8(rgba, 1, 1, s.exposure(), s.tonemap(), srgb);
+        e["srgb8"] = json::array({srgb[0], srgb[1], srgb[2]});
+        e["offset"] = json::array({sample_pattern(px.samples).pixel_x(k), sample_pattern(px.samples).pixel_y(k)});
         samples.push_back(e);
     }
-    j["sample_colors"] = samples;
+    j["sample_list"] = samples;
     j["winner"] = px.contributors.empty() ? -1 : px.contributors[0];
     j["linear"] = j3(px.linear);
     j["srgb8"] = json::array({px.srgb8[0], px.srgb8[1], px.srgb8[2]});
