@@ -24,7 +24,7 @@ std::size_t Recording::bytes() const {
          setups.size() * sizeof(TriangleSetup) + piece_tiles.size() * sizeof(std::uint32_t);
     for (const TileRecord& t : tiles)
         n += sizeof t + t.pieces.size() * sizeof(std::uint32_t) + t.blocks.size() * sizeof(BlockRecord) +
-             t.z.size() * sizeof(float);
+             t.z.size() * sizeof(float) + t.masks.size() * sizeof(std::uint16_t);
     return n;
 }
 
@@ -61,6 +61,7 @@ public:
         void fragments(std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass, const float* z) {
             r->fragments(draw, prim, bx, by, mask, pass, z);
         }
+        void samples(std::uint32_t, int bx, int by, const SampleCoverage& sc) { r->samples(bx, by, sc); }
         template <int NV>
         void shaded(const FragmentBlock<NV>& in, const FragmentOut&, std::uint32_t live) {
             r->shaded(draw, in.x, in.y, in.prim_id, in.mask, live);
@@ -72,6 +73,7 @@ public:
         DrawRecord d;
         d.mesh = mesh;
         d.state = st;
+        d.visible = draws_visible(st, rec_.visibility);
         d.first_triangle = first;
         d.triangle_count = triangles;
         d.vertex_count = vertices;
@@ -135,9 +137,20 @@ private:
         b.pass = std::uint16_t(pass);
         b.shaded = 0;
         b.live = 0;
-        b.z = std::uint32_t(t.z.size());
-        for (std::uint32_t m = mask & 0xFFFFu; m; m &= m - 1) t.z.push_back(z[__builtin_ctz(m)]);
+        b.z = std::uint32_t(t.z.size());  // the depths come with samples(), right after
+        b.masks = std::uint32_t(t.masks.size());
         t.blocks.push_back(b);
+        (void)z;
+    }
+
+    void samples(int bx, int by, const SampleCoverage& sc) {
+        // Right after fragments() for the same block, on the same thread.
+        TileRecord& t = rec_.tiles[std::size_t(rec_.tile_of(bx, by))];
+        for (int s = 0; s < sc.count; ++s)
+            for (std::uint32_t m = sc.cover[s] & 0xFFFFu; m; m &= m - 1) t.z.push_back(sc.z[s][__builtin_ctz(m)]);
+        if (sc.count == 1) return;
+        for (int s = 0; s < sc.count; ++s) t.masks.push_back(std::uint16_t(sc.cover[s]));
+        for (int s = 0; s < sc.count; ++s) t.masks.push_back(std::uint16_t(sc.pass[s]));
     }
 
     void shaded(std::size_t draw, int x, int y, std::uint32_t prim, std::uint32_t in_mask, std::uint32_t live) {
@@ -212,20 +225,26 @@ void RecordingObserver::finish() {
             rec_.tiles[rec_.piece_tiles[pr.first_tile + i]].pieces.push_back(std::uint32_t(p));
     }
     // A block belongs to the one piece of its triangle that covers its
-    // first covered pixel (pieces of a clipped triangle never overlap).
+    // first covered sample (pieces of a clipped triangle never overlap).
+    const SamplePattern& sp = sample_pattern(rec_.samples);
     for (TileRecord& t : rec_.tiles)
         for (BlockRecord& b : t.blocks) {
             const TriangleRecord& tr = rec_.triangles[b.piece];
             std::uint32_t piece = tr.first_piece;
             if (tr.piece_count > 1) {
-                const int lane = __builtin_ctz(b.mask);
+                int s = 0;
+                while (!rec_.cover(t, b, s)) ++s;
+                const int lane = __builtin_ctz(rec_.cover(t, b, s));
                 const int x = b.bx + lane_x(lane), y = b.by + lane_y(lane);
                 for (std::uint32_t k = 0; k < tr.piece_count; ++k) {
                     const PieceRecord& pr = rec_.pieces[tr.first_piece + k];
                     if (pr.setup == kNone) continue;
-                    const TriangleSetup& s = rec_.setups[pr.setup];
-                    if (edge_at_pixel(s, 0, x, y) >= 0 && edge_at_pixel(s, 1, x, y) >= 0 &&
-                        edge_at_pixel(s, 2, x, y) >= 0) {
+                    const TriangleSetup& st = rec_.setups[pr.setup];
+                    bool inside = true;
+                    for (int e = 0; e < 3; ++e)
+                        inside &= edge_at_pixel(st, e, x, y) + std::int64_t(st.A[e]) * sp.fixed_x(s) +
+                                      std::int64_t(st.B[e]) * sp.fixed_y(s) >= 0;
+                    if (inside) {
                         piece = tr.first_piece + k;
                         break;
                     }
@@ -249,6 +268,8 @@ void record_frame(StepScene& s, Recording& rec) {
     rec.tiles_x = (rec.width + rec.tile_size - 1) / rec.tile_size;
     rec.tiles_y = (rec.height + rec.tile_size - 1) / rec.tile_size;
     rec.tiles.resize(std::size_t(rec.tiles_x) * rec.tiles_y);
+    rec.samples = s.settings.samples;
+    rec.visibility = s.settings.visibility;
     std::size_t total = 0;
     for (const Mesh& m : s.scene.meshes)
         if (!m.indices.empty()) total += m.indices.size() / 3;
