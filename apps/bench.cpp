@@ -4,6 +4,11 @@
 //
 //   bench [--workload quad,grid,bottle,tea,bunny,builtin] [--threads 1,2] [--repeat N] [--json]
 //   bench [SCENE] [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME] [--flat]
+//         [--shadows on|off|both] [--shadow-size N] [--blend ALPHA]
+//                                        (shadow maps on, off, or both side by side per
+//                                        configuration; --blend: every material alpha BLEND
+//                                        with that alpha, the worst case of transparency;
+//                                        --shadows applies to the workloads too)
 //                                        (any scene, the built-in one by default; --tiles, --view
 //                                        or --flat without SCENE also select this mode)
 //   bench --write-workloads DIR          the synthetic workloads as files, plus DIR/commands.txt
@@ -377,7 +382,15 @@ struct Result {
     double coverage = 0;  // fraction of pixels drawn
 };
 
-Result measure(const Workload& w, int threads, int tile, int repeat, int width, int height) {
+// bench --shadows / --shadow-size / --blend.
+struct FeatureOptions {
+    std::vector<bool> shadows{false};  // each configuration is measured once per entry
+    int shadow_size = ShadowSettings{}.size;
+    float blend_alpha = -1.0f;         // >= 0: every material BLEND with this alpha
+};
+
+Result measure(const Workload& w, int threads, int tile, int repeat, int width, int height, bool shadows,
+               int shadow_size) {
     Result r;
     r.name = w.name;
     auto t_load = Clock::now();
@@ -424,6 +437,8 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
         fs.lights = {sun};
     }
     fs.ambient = glm::vec3(0.05f);
+    fs.shadows.enabled = shadows;
+    fs.shadows.size = shadow_size;
     Framebuffer fb(width, height);
     std::vector<double> frame, vertex, setup, raster;
     for (int i = 0; i <= repeat; ++i) {  // frame 0 warms up (pages in the framebuffer)
@@ -607,7 +622,7 @@ double render_flat(Renderer& renderer, const Scene& scene, const Camera& cam, Fr
 }
 
 int bench_scene(const std::string& scene_path, int width, int height, const std::vector<int>& threads,
-                const std::vector<int>& tiles, int repeat, DebugView view, bool flat) {
+                const std::vector<int>& tiles, int repeat, DebugView view, bool flat, const FeatureOptions& fo) {
     DefaultScene builtin;
     Scene loaded;
     const Scene* scene = nullptr;
@@ -627,19 +642,31 @@ int bench_scene(const std::string& scene_path, int width, int height, const std:
         std::fprintf(stderr, "bench: %s\n", e.what());
         return 1;
     }
+    Scene blended;
+    if (fo.blend_alpha >= 0.0f) {
+        blended = *scene;
+        for (Material& m : blended.materials) {
+            m.alpha_mode = AlphaMode::Blend;
+            m.base_color_factor.a = fo.blend_alpha;
+        }
+        scene = &blended;
+    }
     std::vector<ShadingLight> lights = shading_lights(*scene);
     if (lights.empty()) lights = default_light_rig();
-    std::printf("scene %s, %zu triangles, %dx%d, %d frames per configuration, %s program\n",
+    std::printf("scene %s, %zu triangles, %dx%d, %d frames per configuration, %s program%s\n",
                 scene_path.empty() ? "(built-in)" : scene_path.c_str(), scene->triangle_count(), width, height,
-                repeat, flat ? "flat Lambert" : "PBR");
+                repeat, flat ? "flat Lambert" : "PBR", fo.blend_alpha >= 0.0f ? ", every material BLEND" : "");
     for (int tile : tiles)
-        for (int t : threads) {
+        for (int t : threads)
+            for (bool shadows : fo.shadows) {
             Renderer renderer({t, tile});
             SceneRenderer sr(*scene, renderer);
             FrameSettings fs;
             fs.camera = camera;
             fs.lights = lights;
             fs.view = view;
+            fs.shadows.enabled = shadows;
+            fs.shadows.size = fo.shadow_size;
             Framebuffer fb(width, height);
             std::vector<double> ms;
             FrameStats last;
@@ -656,9 +683,9 @@ int bench_scene(const std::string& scene_path, int width, int height, const std:
                 last = renderer.stats();
             }
             const Summary s = summarise(ms);
-            std::printf("threads %d tile %3d: frame_ms min=%.2f median=%.2f max=%.2f  %.1f Mpx/s"
+            std::printf("threads %d tile %3d shadows %-3s: frame_ms min=%.2f median=%.2f max=%.2f  %.1f Mpx/s"
                         "  (vertex %.2f, setup+bin %.2f, raster+shade %.2f ms)\n",
-                        t, tile, s.min, s.median, s.max, double(width) * height / s.median / 1000.0,
+                        t, tile, shadows ? "on" : "off", s.min, s.median, s.max, double(width) * height / s.median / 1000.0,
                         last.ms_vertex, last.ms_setup_bin, last.ms_raster);
         }
     return 0;
@@ -668,6 +695,7 @@ int usage() {
     std::fprintf(stderr,
                  "usage: bench [--workload quad,grid,bottle,tea,bunny,builtin] [--threads 1,2] [--repeat N] [--json]\n"
                  "       bench SCENE [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME] [--flat]\n"
+                 "             [--shadows on|off|both] [--shadow-size N] [--blend ALPHA]\n"
                  "       bench --write-workloads DIR\n"
                  "       bench --side-by-side RENDER_A RENDER_B [--workload ...] [--runs N] [--repeat N]\n"
                  "       bench --psnr A.png B.png\n"
@@ -688,7 +716,8 @@ int main(int argc, char** argv) {
     std::vector<int> threads = {2}, tiles = {kDefaultTileSize};
     std::vector<std::string> names;
     DebugView view = DebugView::None;
-    bool flat = false, json = false, threads_given = false, tiles_given = false;
+    bool flat = false, json = false, threads_given = false, tiles_given = false, blend_given = false;
+    FeatureOptions features;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -702,6 +731,20 @@ int main(int argc, char** argv) {
         else if (a == "--runs") runs = std::max(1, std::atoi(next().c_str()));
         else if (a == "--view") { if (!parse_debug_view(next(), view)) return usage(); }
         else if (a == "--flat") flat = true;
+        else if (a == "--shadows") {
+            const std::string v = next();
+            if (v == "on") features.shadows = {true};
+            else if (v == "off") features.shadows = {false};
+            else if (v == "both") features.shadows = {false, true};
+            else return usage();
+        } else if (a == "--shadow-size") {
+            features.shadow_size = std::atoi(next().c_str());
+            if (features.shadow_size < kMinShadowSize || features.shadow_size > kMaxShadowSize) return usage();
+        } else if (a == "--blend") {
+            features.blend_alpha = float(std::atof(next().c_str()));
+            if (!(features.blend_alpha >= 0.0f && features.blend_alpha <= 1.0f)) return usage();
+            blend_given = true;
+        }
         else if (a == "--json") json = true;
         else if (a == "--workload") names = split(next());
         else if (a == "--workloads") dir = next();
@@ -715,9 +758,9 @@ int main(int argc, char** argv) {
     try {
         if (!psnr_a.empty()) return psnr(psnr_a, psnr_b);
         // A scene, a tile sweep, a debug view or the flat program: the scene mode.
-        if (!scene_path.empty() || flat || tiles_given || view != DebugView::None)
+        if (!scene_path.empty() || flat || tiles_given || view != DebugView::None || blend_given)
             return bench_scene(scene_path, width, height, threads_given ? threads : std::vector<int>{1, 2}, tiles,
-                               repeat, view, flat);
+                               repeat, view, flat, features);
         if (!write_dir.empty()) {
             ensure_workloads(write_dir, true);
             std::ofstream cmds(fs::path(write_dir) / "commands.txt");
@@ -743,9 +786,11 @@ int main(int argc, char** argv) {
         if (!exes.empty()) return side_by_side(exes, list, runs, repeat, std::to_string(threads.back()));
         std::vector<std::string> out;
         for (const Workload& w : list)
-            for (int t : threads) {
-                Result r = measure(w, t, tiles.front(), repeat, width, height);
+            for (int t : threads)
+                for (bool shadows : features.shadows) {
+                Result r = measure(w, t, tiles.front(), repeat, width, height, shadows, features.shadow_size);
                 r.threads = t;
+                if (shadows) r.name += "+shadows";
                 if (!json) print_result(r);
                 out.push_back(json_result(r));
             }

@@ -288,6 +288,7 @@ int run(int argc, char** argv) {
     settings.model = opt.brdf;
     settings.view = opt.view;
     settings.samples = opt.msaa;
+    settings.shadows = opt.shadows;
 
     progress.begin(1, "decoding textures");
     auto t_tex = Clock::now();

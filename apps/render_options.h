@@ -57,6 +57,7 @@ struct RenderOptions {
     glm::vec3 ambient{0.03f};
     bool no_default_lights = false;
     BrdfModel brdf = BrdfModel::Default;
+    ShadowSettings shadows{false, 2048};  // --shadows on|off, --shadow-size N
     float exposure = 1.0f;
     // Default aces (highlights roll off instead of clipping, so `render
     // model.glb` looks right at once); none when a --view shows raw data.
@@ -101,7 +102,7 @@ inline const char* render_usage() {
 "  --exposure E --tonemap none|aces|neutral   default 1, aces (none with --view)\n"
 "  --view NAME          albedo normal roughness metallic uv depth overdraw tiles\n"
 "                       ndf fresnel geometry diffuse specular\n"
-"  --msaa N             samples per pixel: 1, 2, 4 or 8 (default 4)\n"
+"  --msaa 1|2|4|8 (default 4)  --shadows on|off (off)  --shadow-size N (2048)\n"
 "  --threads N          default: all cores      --tile N  16..256 (default 64)\n"
 "  --frames N --orbit DEG  turntable: N images orbiting the target around --up,\n"
 "                       DEG in total (default 360); FILE needs %04d\n"
@@ -368,6 +369,18 @@ inline std::string parse_render_args(int argc, const char* const* argv, RenderOp
         } else if (flag == "--brdf") {
             if (!(err = value("default|gltf", v)).empty()) return err;
             if (!parse_brdf_model(v, out.brdf)) return bad(v, "expected default or gltf");
+        } else if (flag == "--shadows") {
+            if (!(err = value("on|off", v)).empty()) return err;
+            if (v != "on" && v != "off") return bad(v, "expected on or off");
+            out.shadows.enabled = v == "on";
+        } else if (flag == "--shadow-size") {
+            if (!(err = value("N", v)).empty()) return err;
+            long n;
+            if (!parse_integer(v, n)) return bad(v, "not an integer");
+            if (n < kMinShadowSize || n > kMaxShadowSize)
+                return bad(v, "must be between " + std::to_string(kMinShadowSize) + " and " +
+                                  std::to_string(kMaxShadowSize) + " texels");
+            out.shadows.size = int(n);
         } else if (flag == "--exposure") {
             if (!(err = value("E", v)).empty()) return err;
             double d;

@@ -529,7 +529,7 @@ private:
         if (g.alphaMode == "MASK") {
             m.alpha_mode = AlphaMode::Mask;
         } else if (g.alphaMode == "BLEND") {
-            warn(what + ": alphaMode BLEND is not supported, drawn opaque");
+            m.alpha_mode = AlphaMode::Blend;
         } else if (g.alphaMode != "OPAQUE") {
             warn(what + ": unknown alphaMode '" + g.alphaMode + "', drawn opaque");
         }

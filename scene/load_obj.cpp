@@ -9,6 +9,7 @@
 // number.
 #include "scene/load_scene.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -330,9 +331,15 @@ private:
                 scene_.warnings.push_back(path_ + ": material '" + name + "': unknown conductor 'Pc " +
                                           c + "' ignored");
         }
-        if (src.dissolve < 1.0 || !src.alpha_texname.empty())
-            scene_.warnings.push_back(path_ + ": material '" + name +
-                                      "': transparency (d / map_d) ignored, drawn opaque");
+        // Dissolve (`d`, or 1 - `Tr` as tinyobjloader reads it): glTF's BLEND
+        // with the base colour's alpha (README "Transparency").
+        const double dissolve = src.dissolve;
+        if (std::isfinite(dissolve) && dissolve < 1.0) {
+            m.alpha_mode = AlphaMode::Blend;
+            m.base_color_factor.a = float(std::max(0.0, dissolve));
+        }
+        if (!src.alpha_texname.empty())
+            scene_.warnings.push_back(path_ + ": material '" + name + "': map_d ignored (d / Tr are used)");
         return m;
     }
 

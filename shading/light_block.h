@@ -14,6 +14,7 @@
 
 #include "raster/limits.h"
 #include "shading/brdf.h"
+#include "shading/shadow_lanes.h"
 #include "shading/surface.h"
 
 namespace prast {
@@ -22,9 +23,11 @@ struct MaterialBlock {
     static constexpr int N = kBlockLanes;
     alignas(64) float Px[N], Py[N], Pz[N];        // world position
     alignas(64) float Nx[N], Ny[N], Nz[N];        // shading normal (unit)
+    alignas(64) float Gx[N], Gy[N], Gz[N];        // geometric normal (unit; for shadow lookups)
     alignas(64) float ar[N], ag[N], ab[N];        // albedo
     alignas(64) float metallic[N], roughness[N], occlusion[N];
     alignas(64) float er[N], eg[N], eb[N];        // emissive
+    alignas(64) float alpha[N];                   // base colour alpha (BLEND's coverage; 1 otherwise)
     float ior = 1.5f;                             // per material, uniform
 };
 
@@ -46,6 +49,10 @@ inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L
     const float Lpx = L.position.x, Lpy = L.position.y, Lpz = L.position.z;
     const float Ldx = L.direction.x, Ldy = L.direction.y, Ldz = L.direction.z;
     const float Lr = L.radiance.x, Lg = L.radiance.y, Lb = L.radiance.z;
+    // Shadow: light_visibility() per lane, 1 without a map.
+    alignas(64) float vis[N];
+    if (L.shadow) shadow_visibility_lanes<N>(*L.shadow, m.Px, m.Py, m.Pz, m.Gx, m.Gy, m.Gz, L.direction, vis);
+    else for (int l = 0; l < N; ++l) vis[l] = 1.0f;
     for (int l = 0; l < N; ++l) {
         // Light direction and radiance at P (light_at).
         float lx = Ldx, ly = Ldy, lz = Ldz, Rr = Lr, Rg = Lg, Rb = Lb;
@@ -62,6 +69,7 @@ inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L
             Rg = ok ? Lg / dd : 0.0f;
             Rb = ok ? Lb / dd : 0.0f;
         }
+        Rr *= vis[l]; Rg *= vis[l]; Rb *= vis[l];
         // Cosines and h.
         float hx = lx + vx[l], hy = ly + vy[l], hz = lz + vz[l];
         float hl2 = hx * hx + hy * hy + hz * hz;

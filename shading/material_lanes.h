@@ -72,7 +72,8 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     const Texture* maps[kMaps] = {bm.base_color, bm.metallic_roughness, bm.roughness, bm.metallic,
                                   bm.normal, bm.occlusion, bm.emissive};
     const bool mask_mode = m.alpha_mode == AlphaMode::Mask;
-    const std::uint8_t used[kMaps] = {std::uint8_t(mask_mode ? 0xF : 0x7), 0x6, 0x1, 0x1, 0x7, 0x1, 0x7};
+    const bool alpha_read = mask_mode || m.alpha_mode == AlphaMode::Blend;
+    const std::uint8_t used[kMaps] = {std::uint8_t(alpha_read ? 0xF : 0x7), 0x6, 0x1, 0x1, 0x7, 0x1, 0x7};
     TexelLanes texel[kMaps];
     const TexelLanes* tl[kMaps];
     for (int i = 0; i < kMaps; ++i) tl[i] = &texel[i];
@@ -129,8 +130,10 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         for (int l = 0; l < N; ++l) {
             mb.ar[l] = bf.r * t.r[l]; mb.ag[l] = bf.g * t.g[l]; mb.ab[l] = bf.b * t.b[l];
         }
-        if (mask_mode)  // alpha matters only to the mask (and is read only then)
+        if (alpha_read)  // alpha matters only to MASK and BLEND (and is read only then)
             for (int l = 0; l < N; ++l) alpha[l] = bf.a * t.a[l];
+        else
+            for (int l = 0; l < N; ++l) alpha[l] = bf.a;
     } else {
         for (int l = 0; l < N; ++l) {
             mb.ar[l] = bf.r; mb.ag[l] = bf.g; mb.ab[l] = bf.b;
@@ -193,6 +196,7 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     const float flip = s.front_facing ? 1.0f : -1.0f;
     for (int l = 0; l < N; ++l) {
         mb.Nx[l] = Nx[l] * flip; mb.Ny[l] = Ny[l] * flip; mb.Nz[l] = Nz[l] * flip;
+        mb.Gx[l] = mb.Nx[l]; mb.Gy[l] = mb.Ny[l]; mb.Gz[l] = mb.Nz[l];
     }
     if (maps[kNormal]) {
         // Tangent space, OpenGL convention: red along T (+u), green along
@@ -232,6 +236,8 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     }
 
     copy_lanes<N>(mb.Px, s.Px); copy_lanes<N>(mb.Py, s.Py); copy_lanes<N>(mb.Pz, s.Pz);
+
+    copy_lanes<N>(mb.alpha, alpha);
 
     // Alpha MASK: discard below the cutoff (NaN alpha too).
     std::uint32_t kill = 0;

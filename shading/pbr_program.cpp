@@ -25,6 +25,7 @@ glm::vec3 sum_lobes(const MaterialSample& ms, const SurfacePoint& sp, const Shad
     for (const ShadingLight& L : ctx.lights) {
         glm::vec3 radiance;
         light_at(L, sp.P, bi.l, radiance);
+        radiance *= light_visibility(L, sp.P, ms.N_geom);
         BrdfTerms t = evaluate_brdf(bi, ctx.model);
         sum += (specular ? t.specular : t.diffuse) * radiance * t.NoL;
     }
@@ -100,10 +101,12 @@ void PbrProgram::shade_lanes(const FragmentBlock<kVaryings>& in, FragmentOut& ou
     RadianceBlock rb;
     shade_block_lanes<N>(mb, *ctx, rb);
 
+    // Alpha: the blend weight of BLEND materials (README "Transparency"), 1 otherwise.
+    const bool blend = material->m->alpha_mode == AlphaMode::Blend;
     if constexpr (N == kBlockLanes) {
         out.kill = kill;
         for (int l = 0; l < N; ++l) {
-            out.r[l] = rb.r[l]; out.g[l] = rb.g[l]; out.b[l] = rb.b[l]; out.a[l] = 1.0f;
+            out.r[l] = rb.r[l]; out.g[l] = rb.g[l]; out.b[l] = rb.b[l]; out.a[l] = blend ? mb.alpha[l] : 1.0f;
         }
     } else {
         std::fill(out.r, out.r + kBlockLanes, 0.0f);
@@ -113,7 +116,7 @@ void PbrProgram::shade_lanes(const FragmentBlock<kVaryings>& in, FragmentOut& ou
         std::uint32_t block_kill = 0;
         for (std::uint32_t m = live; m; m &= m - 1) {
             const int i = __builtin_ctz(m), l = lane[i];
-            out.r[l] = rb.r[i]; out.g[l] = rb.g[i]; out.b[l] = rb.b[i];
+            out.r[l] = rb.r[i]; out.g[l] = rb.g[i]; out.b[l] = rb.b[i]; out.a[l] = blend ? mb.alpha[i] : 1.0f;
             block_kill |= ((kill >> i) & 1u) << l;
         }
         out.kill = block_kill;
@@ -173,6 +176,7 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
         case DebugView::Specular: c = sum_lobes(ms, sp, *ctx, true); break;
         }
         out.r[l] = c.r; out.g[l] = c.g; out.b[l] = c.b;
+        if (m.alpha_mode == AlphaMode::Blend) out.a[l] = ms.alpha;
     }
 }
 

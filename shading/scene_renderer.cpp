@@ -1,5 +1,6 @@
 // Texture binding and frame rendering for a Scene; see scene_renderer.h.
 #include "shading/scene_renderer.h"
+#include "shading/transparency.h"
 
 #include <algorithm>
 #include <cmath>
@@ -154,7 +155,17 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
     }
 }
 
+std::vector<ShadingLight> SceneRenderer::shadowed_lights(const FrameSettings& s, float aspect) {
+    std::vector<ShadingLight> lights = s.lights;
+    const bool lit = s.view == DebugView::None || s.view == DebugView::Tiles || s.view == DebugView::Diffuse ||
+                     s.view == DebugView::Specular;
+    if (s.shadows.enabled && lit)
+        shadow_maps_.draw(scene_, bound_, renderer_, s.shadows, s.camera, aspect, lights);
+    return lights;
+}
+
 void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out) {
+    std::vector<ShadingLight> lights = shadowed_lights(s, float(fb.width) / float(fb.height));
     renderer_.begin_frame();
     FrameOptions frame;  // cleared to black, alpha 1, depth 1, in the tile pass
     frame.samples = s.samples;
@@ -162,14 +173,19 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
     renderer_.begin(fb, frame);
     ShadingContext ctx;
     ctx.eye = s.camera.eye;
-    ctx.lights = s.lights;
+    ctx.lights = std::move(lights);
     ctx.ambient = s.ambient;
     ctx.model = s.model;
     const float aspect = float(fb.width) / float(fb.height);
     const glm::mat4 vp = s.camera.view_projection(aspect);
     static const Material kFallback;
     static const BoundMaterial kFallbackBound{&kFallback};
-    for (const Mesh& mesh : scene_.meshes) {
+    // Opaque and MASK meshes in file order, then BLEND ones back to front,
+    // blended over what is drawn (lit views; data views draw them opaque).
+    const bool lit = s.view == DebugView::None || s.view == DebugView::Tiles || s.view == DebugView::Diffuse ||
+                     s.view == DebugView::Specular;
+    for (const std::size_t mi : draw_order(scene_, s.camera.eye)) {
+        const Mesh& mesh = scene_.meshes[mi];
         if (mesh.indices.empty()) continue;
         const BoundMaterial* bm = mesh.material >= 0 && std::size_t(mesh.material) < bound_.size()
                                       ? &bound_[std::size_t(mesh.material)] : &kFallbackBound;
@@ -184,6 +200,10 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
         DrawState st;
         st.cull = bm->m->double_sided ? CullMode::None : CullMode::Back;
         st.may_discard = bm->m->alpha_mode == AlphaMode::Mask;  // shaded in order: discards decide visibility
+        if (lit && bm->m->alpha_mode == AlphaMode::Blend) {
+            st.blend = Blend::Alpha;  // per sample, in linear radiance
+            st.depth_write = false;
+        }
         if (s.view == DebugView::Overdraw) {
             st.blend = Blend::Add;
             st.depth_test = false;

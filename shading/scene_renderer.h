@@ -12,6 +12,7 @@
 #include "shading/debug_view.h"
 #include "shading/pbr_program.h"
 #include "scene/scene.h"
+#include "shading/shadow_pass.h"
 #include "shading/surface.h"
 #include "shading/texture.h"
 #include "shading/tonemap.h"
@@ -24,6 +25,7 @@ struct FrameSettings {
     glm::vec3 ambient{0.03f};
     BrdfModel model = BrdfModel::Default;
     DebugView view = DebugView::None;
+    ShadowSettings shadows;  // shadow maps for every light (off by default; render turns them on)
     int samples = 1;  // per pixel: 1, 2, 4 or 8 (README "Anti-aliasing")
     // Where the visibility pass runs (the bytes are the same either way).
     FrameOptions::Visibility visibility = FrameOptions::Visibility::Auto;
@@ -56,6 +58,12 @@ public:
     // `out`, also writes the 8-bit image (in the tile pass, on every thread).
     void render(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out = nullptr);
 
+    // The frame's lights, each pointing at its shadow map drawn for these
+    // settings (valid until the next call); the lights as they are when
+    // shadows are off or the view shows no lighting. render() calls it.
+    std::vector<ShadingLight> shadowed_lights(const FrameSettings& settings, float aspect);
+    const ShadowMaps& shadow_maps() const { return shadow_maps_; }
+
     const std::vector<std::string>& warnings() const { return warnings_; }
     const std::vector<BoundMaterial>& materials() const { return bound_; }
     const Scene& scene() const { return scene_; }
@@ -68,6 +76,7 @@ private:
     std::vector<std::unique_ptr<Texture>> packed_;    // OBJ roughness + metal pairs
     std::vector<BoundMaterial> bound_;
     std::vector<std::string> warnings_;
+    ShadowMaps shadow_maps_;
 };
 
 // Debug-view post passes, exposed for tests.

@@ -11,6 +11,7 @@
 
 #include "shading/brdf.h"
 #include "scene/scene.h"
+#include "shading/shadow_map.h"
 #include "shading/texture.h"
 
 namespace prast {
@@ -56,6 +57,7 @@ struct ShadingLight {
     glm::vec3 direction{0.0f, 1.0f, 0.0f};  // directional: towards the light
     glm::vec3 position{0.0f};               // point
     glm::vec3 radiance{1.0f};               // colour * intensity
+    const ShadowMap* shadow = nullptr;      // its shadow map this frame (shadow_pass.h), or none
 };
 
 struct ShadingContext {
@@ -78,6 +80,14 @@ inline void light_at(const ShadingLight& L, const glm::vec3& P, glm::vec3& l, gl
     if (!(d2 > 1e-12f)) { l = glm::vec3(0.0f, 0.0f, 1.0f); radiance = glm::vec3(0.0f); return; }
     l = d / std::sqrt(d2);
     radiance = L.radiance / d2;
+}
+
+// The fraction of the light reaching P (geometric normal Ng) past the shadow
+// map's casters: 1 without a map. It multiplies the light's radiance.
+inline float light_visibility(const ShadingLight& L, const glm::vec3& P, const glm::vec3& Ng) {
+    if (!L.shadow) return 1.0f;
+    return shadow_pcf(*L.shadow, shadow_tap(*L.shadow, P.x, P.y, P.z, Ng.x, Ng.y, Ng.z, L.direction.x,
+                                             L.direction.y, L.direction.z));
 }
 
 // Level of detail of each bound texture, from the uv derivatives of a 2x2
@@ -192,6 +202,7 @@ inline glm::vec3 shade_surface(const MaterialSample& ms, const SurfacePoint& sp,
     for (const ShadingLight& L : ctx.lights) {
         glm::vec3 radiance;
         light_at(L, sp.P, in.l, radiance);
+        radiance *= light_visibility(L, sp.P, ms.N_geom);
         BrdfTerms t = evaluate_brdf(in, ctx.model);
         Lo += t.f * radiance * t.NoL;
         if (terms) terms->push_back(t);
