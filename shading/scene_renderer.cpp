@@ -5,6 +5,8 @@
 #include <cmath>
 #include <mutex>
 
+#include "scene/image.h"
+
 namespace prast {
 
 std::vector<ShadingLight> shading_lights(const Scene& scene) {
@@ -95,14 +97,43 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
     }
 }
 
-void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb) {
-    renderer_.clear(fb, 0.0f, 0.0f, 0.0f, 1.0f);
-    renderer_.begin_frame();
+const Environment* SceneRenderer::environment(const FrameSettings& s) {
+    if (s.environment) return s.environment;
+    if (!s.scene_environment || !scene_.environment) return nullptr;
+    if (!scene_env_)
+        scene_env_ = std::make_unique<Environment>(
+            Environment::build(*scene_.environment, EnvironmentSettings{}, renderer_.pool()));
+    return scene_env_.get();
+}
+
+const DfgTable& SceneRenderer::dfg_table(DfgModel model) {
+    std::unique_ptr<DfgTable>& t = dfg_[int(model)];
+    if (!t) t = std::make_unique<DfgTable>(DfgTable::build(model, renderer_.pool()));
+    return *t;
+}
+
+ShadingContext SceneRenderer::shading_context(const FrameSettings& s) {
     ShadingContext ctx;
     ctx.eye = s.camera.eye;
     ctx.lights = s.lights;
     ctx.ambient = s.ambient;
     ctx.model = s.model;
+    const bool gltf = s.model == BrdfModel::Gltf;
+    ctx.env = environment(s);
+    if (ctx.env) {
+        ctx.dfg_ibl = &dfg_table(gltf ? DfgModel::HeightCorrelated : DfgModel::SchlickIbl);
+        ctx.ibl = s.ibl;
+        ctx.ibl_samples = s.ibl_samples;
+    }
+    ctx.energy = s.energy;
+    if (s.energy) ctx.dfg_light = &dfg_table(gltf ? DfgModel::HeightCorrelated : DfgModel::SchlickDirect);
+    return ctx;
+}
+
+void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb) {
+    const ShadingContext ctx = shading_context(s);
+    renderer_.clear(fb, 0.0f, 0.0f, 0.0f, 1.0f);
+    renderer_.begin_frame();
     const float aspect = float(fb.width) / float(fb.height);
     const glm::mat4 vp = s.camera.view_projection(aspect);
     static const Material kFallback;
@@ -128,6 +159,8 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb) {
         }
         renderer_.draw(fb, prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(), mesh.indices.size(), st);
     }
+    if (s.view == DebugView::None || s.view == DebugView::Tiles)
+        draw_background(fb, s.camera, ctx.env, s.background, s.background_color, renderer_.pool());
     if (s.view == DebugView::Overdraw) apply_overdraw_heat(fb);
     if (s.view == DebugView::Tiles) apply_tile_overlay(fb, renderer_.tile_entries(), renderer_.tile_size());
 }

@@ -9,7 +9,10 @@
 
 #include "raster/pipeline.h"
 #include "scene/camera.h"
+#include "shading/background.h"
 #include "shading/debug_view.h"
+#include "shading/dfg.h"
+#include "shading/environment.h"
 #include "shading/pbr_program.h"
 #include "scene/scene.h"
 #include "shading/surface.h"
@@ -23,6 +26,17 @@ struct FrameSettings {
     glm::vec3 ambient{0.03f};
     BrdfModel model = BrdfModel::Default;
     DebugView view = DebugView::None;
+    // Image-based lighting: this environment, or when null the scene's own
+    // (Scene::environment, prefiltered on first use) unless scene_environment
+    // is false. With one, it replaces the ambient term.
+    const Environment* environment = nullptr;
+    bool scene_environment = true;
+    IblMode ibl = IblMode::SplitSum;
+    int ibl_samples = 256;
+    bool energy = false;   // --energy conserve
+    // Env and Blur need an environment (without one they draw black).
+    Background background = Background::Env;
+    glm::vec3 background_color{0.0f};
 };
 
 // Scene lights (KHR_lights_punctual) in shading form.
@@ -42,6 +56,13 @@ public:
     // draws every mesh, and applies the overdraw/tiles debug overlays.
     void render(const FrameSettings& settings, Framebuffer& fb);
 
+    // The environment a frame with these settings is lit by (null: none).
+    const Environment* environment(const FrameSettings& settings);
+    // A DFG table, built on the renderer's pool on first use.
+    const DfgTable& dfg_table(DfgModel model);
+    // The context render() shades with (lights, eye, environment, tables).
+    ShadingContext shading_context(const FrameSettings& settings);
+
     const std::vector<std::string>& warnings() const { return warnings_; }
     const std::vector<BoundMaterial>& materials() const { return bound_; }
     const Scene& scene() const { return scene_; }
@@ -53,6 +74,8 @@ private:
     std::vector<std::unique_ptr<Texture>> textures_;  // [image * 2 + srgb]
     std::vector<BoundMaterial> bound_;
     std::vector<std::string> warnings_;
+    std::unique_ptr<Environment> scene_env_;   // from Scene::environment, on first use
+    std::unique_ptr<DfgTable> dfg_[3];         // by DfgModel, on first use
 };
 
 // Debug-view post passes, exposed for tests.
