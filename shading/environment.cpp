@@ -37,7 +37,8 @@ float luminance(const glm::vec4& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0
 } // namespace
 
 Environment Environment::build(const Image& img, const EnvironmentSettings& s, ThreadPool& pool) {
-    if (img.empty() || img.rgba.size() != std::size_t(img.width) * std::size_t(img.height) * 4)
+    if (img.empty() || (!img.is_8bit() && img.rgba.size() != img.texel_count() * 4) ||
+        (img.is_8bit() && img.pixels.size() != img.texel_count() * std::size_t(img.channels)))
         throw std::invalid_argument("environment: empty image");
     Environment env;
     const double turn = double(s.rotate_deg) * M_PI / 180.0;
@@ -69,7 +70,8 @@ Environment Environment::build(const Image& img, const EnvironmentSettings& s, T
 
     // Level 0: the image times the intensity (clamped, NaN to 0), resampled
     // when too wide.
-    auto scaled = [&](const float* p) {
+    auto scaled = [&](int x, int y) {
+        const glm::vec4 p = img.at(x, y);
         glm::vec4 c(0.0f);
         for (int ch = 0; ch < 3; ++ch) {
             const float v = p[ch] * s.intensity;
@@ -80,15 +82,13 @@ Environment Environment::build(const Image& img, const EnvironmentSettings& s, T
     if (!shrink) {
         pool.run(h0, [&](int y, int) {
             for (int x = 0; x < w0; ++x)
-                env.texels_[std::size_t(y) * std::size_t(w0) + std::size_t(x)] =
-                    scaled(&img.rgba[(std::size_t(y) * std::size_t(img.width) + std::size_t(x)) * 4]);
+                env.texels_[std::size_t(y) * std::size_t(w0) + std::size_t(x)] = scaled(x, y);
         });
     } else {
         std::vector<glm::vec4> full(std::size_t(img.width) * std::size_t(img.height));
         pool.run(img.height, [&](int y, int) {
             for (int x = 0; x < img.width; ++x)
-                full[std::size_t(y) * std::size_t(img.width) + std::size_t(x)] =
-                    scaled(&img.rgba[(std::size_t(y) * std::size_t(img.width) + std::size_t(x)) * 4]);
+                full[std::size_t(y) * std::size_t(img.width) + std::size_t(x)] = scaled(x, y);
         });
         const EquirectLevel in = make_level(img.width, img.height, 0);
         std::vector<glm::vec4> tmp = std::move(full);

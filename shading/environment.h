@@ -56,7 +56,8 @@ public:
     // GGX samples per texel for levels 1.. (level 0 is the source).
     static constexpr int kSpecularSamples[kSpecularLevels] = {0, 64, 128, 192, 256, 384, 512, 512};
 
-    // Throws std::invalid_argument when the image is empty or not RGBA.
+    // Throws std::invalid_argument when the image is empty. (8-bit images are
+    // read as their linear values.)
     static Environment build(const Image& equirect, const EnvironmentSettings& settings, ThreadPool& pool);
 
     // Perceptual roughness of specular level i, and the (fractional) level of

@@ -72,6 +72,7 @@ private:
     const Scene& scene_;
     Renderer& renderer_;
     std::vector<std::unique_ptr<Texture>> textures_;  // [image * 2 + srgb]
+    std::vector<std::unique_ptr<Texture>> packed_;    // OBJ roughness + metal pairs
     std::vector<BoundMaterial> bound_;
     std::vector<std::string> warnings_;
     std::unique_ptr<Environment> scene_env_;   // from Scene::environment, on first use
