@@ -16,7 +16,7 @@ namespace {
 // (f_spec / (D F)) (n.l) 4 (v.h) / (n.h). The half vectors depend on the
 // row only, so they are drawn once and reused for every n.v.
 void integrate_specular_row(DfgModel model, double r, glm::dvec2* out) {
-    constexpr int S = DfgTable::kSize, N = DfgTable::kSamples;
+    constexpr int S = DfgTable::kSizeNoV, N = DfgTable::kSamples;
     const double alpha = r * r, a2 = alpha * alpha;
     const double eps = kBrdfMinCos;
     const double k = model == DfgModel::SchlickIbl ? r * r * 0.5 : (r + 1.0) * (r + 1.0) * 0.125;
@@ -64,17 +64,17 @@ double integrate_diffuse_fresnel(double NoV) {
 } // namespace
 
 DfgTable DfgTable::build(DfgModel model, ThreadPool& pool) {
-    constexpr int S = kSize;
+    constexpr int S = kSizeNoV, R = kSizeRough;
     DfgTable t;
     t.model_ = model;
-    t.texels_.assign(std::size_t(S) * S, glm::vec4(0.0f));
+    t.texels_.assign(std::size_t(S) * R, glm::vec4(0.0f));
     std::vector<double> kd(S);
     pool.run(S, [&](int i, int) {
         const double c = double(i) / (S - 1);
         kd[std::size_t(i)] = integrate_diffuse_fresnel(c * c);
     });
-    pool.run(S, [&](int j, int) {
-        const double r = std::clamp(double(j) / (S - 1), double(kMinPerceptualRoughness), 1.0);
+    pool.run(R, [&](int j, int) {
+        const double r = std::clamp(double(j) / (R - 1), double(kMinPerceptualRoughness), 1.0);
         glm::dvec2 ab[S];
         integrate_specular_row(model, r, ab);
         for (int i = 0; i < S; ++i)

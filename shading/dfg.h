@@ -38,14 +38,15 @@ enum class DfgModel { SchlickIbl, SchlickDirect, HeightCorrelated };
 
 class DfgTable {
 public:
-    static constexpr int kSize = 64;        // texels along n.v and along roughness
+    static constexpr int kSizeNoV = 64;     // texels along n.v (the terms change fast near grazing)
+    static constexpr int kSizeRough = 32;   // texels along roughness
     static constexpr int kSamples = 2048;   // GGX half vectors per texel (Hammersley)
 
     static DfgTable build(DfgModel model, ThreadPool& pool);
 
     DfgModel model() const { return model_; }
-    // (A, B, Kd, 0) texels, row-major: row j is roughness j / (kSize - 1)
-    // (clamped to [0.045, 1]), column i is n.v = (i / (kSize - 1))^2: the
+    // (A, B, Kd, 0) texels, row-major: row j is roughness j / (kSizeRough - 1)
+    // (clamped to [0.045, 1]), column i is n.v = (i / (kSizeNoV - 1))^2: the
     // ends (n.v = 0 and 1, r = 1) are texels, not extrapolations, and the
     // columns crowd towards grazing views, where the terms change fastest.
     const glm::vec4* texels() const { return texels_.data(); }
@@ -58,18 +59,18 @@ private:
 };
 
 // The table texels and weights at (n.v, r), shared by the scalar and the lane
-// code: column sqrt(n.v) (kSize - 1), row r (kSize - 1), clamped to the
-// table; NaN reads at 0.
+// code: column sqrt(n.v) (kSizeNoV - 1), row r (kSizeRough - 1), clamped to
+// the table; NaN reads at 0.
 [[gnu::always_inline]] inline void dfg_taps(float NoV, float r, std::int32_t* idx, float& tx, float& ty) {
-    constexpr int S = DfgTable::kSize;
-    const float top = float(S - 1);
-    float x = std::sqrt(NoV) * top, y = r * top;
+    constexpr int S = DfgTable::kSizeNoV, R = DfgTable::kSizeRough;
+    const float right = float(S - 1), top = float(R - 1);
+    float x = std::sqrt(NoV) * right, y = r * top;
     x = x > 0.0f ? x : 0.0f;  // also NaN -> 0
     y = y > 0.0f ? y : 0.0f;
-    x = x < top ? x : top;
+    x = x < right ? x : right;
     y = y < top ? y : top;
     const std::int32_t xi = std::int32_t(x), yi = std::int32_t(y);
-    const std::int32_t x0 = xi < S - 2 ? xi : S - 2, y0 = yi < S - 2 ? yi : S - 2;
+    const std::int32_t x0 = xi < S - 2 ? xi : S - 2, y0 = yi < R - 2 ? yi : R - 2;
     tx = x - float(x0);
     ty = y - float(y0);
     idx[0] = y0 * S + x0;

@@ -257,30 +257,36 @@ inline void ibl_lanes(const MaterialBlock& __restrict m, const ViewLanes& __rest
         Pr[l] = c[0]; Pg[l] = c[1]; Pb[l] = c[2];
     }
     light_block_detail::dfg_lanes<N>(*ctx.dfg_ibl, NoV, w.rough, A, B, Kd);
-    // The two lobes.
-    const bool energy = ctx.energy;
-    for (int l = 0; l < N; ++l) {
-        const float km = 1.0f - m.metallic[l];
-        float sr, sg, sb, kr, kg, kb;
-        if (energy) {
+    // The lobes' weights: specular albedo and kd (the branch outside the loops).
+    alignas(64) float sr[N], sg[N], sb[N], kr[N], kg[N], kb[N];
+    if (ctx.energy) {
+        for (int l = 0; l < N; ++l) {
+            const float km = 1.0f - m.metallic[l];
             const float cr = energy_compensation(w.F0r[l], A[l], B[l]);
             const float cg = energy_compensation(w.F0g[l], A[l], B[l]);
             const float cb = energy_compensation(w.F0b[l], A[l], B[l]);
-            sr = (w.F0r[l] * A[l] + B[l]) * cr;
-            sg = (w.F0g[l] * A[l] + B[l]) * cg;
-            sb = (w.F0b[l] * A[l] + B[l]) * cb;
-            kr = (1.0f - sr) * km; kg = (1.0f - sg) * km; kb = (1.0f - sb) * km;
-        } else {
-            sr = w.F0r[l] * A[l] + B[l];
-            sg = w.F0g[l] * A[l] + B[l];
-            sb = w.F0b[l] * A[l] + B[l];
-            kr = (1.0f - w.F0r[l]) * Kd[l] * km;
-            kg = (1.0f - w.F0g[l]) * Kd[l] * km;
-            kb = (1.0f - w.F0b[l]) * Kd[l] * km;
+            sr[l] = (w.F0r[l] * A[l] + B[l]) * cr;
+            sg[l] = (w.F0g[l] * A[l] + B[l]) * cg;
+            sb[l] = (w.F0b[l] * A[l] + B[l]) * cb;
+            kr[l] = (1.0f - sr[l]) * km; kg[l] = (1.0f - sg[l]) * km; kb[l] = (1.0f - sb[l]) * km;
         }
+    } else {
+        for (int l = 0; l < N; ++l) {
+            const float km = 1.0f - m.metallic[l];
+            sr[l] = w.F0r[l] * A[l] + B[l];
+            sg[l] = w.F0g[l] * A[l] + B[l];
+            sb[l] = w.F0b[l] * A[l] + B[l];
+            kr[l] = (1.0f - w.F0r[l]) * Kd[l] * km;
+            kg[l] = (1.0f - w.F0g[l]) * Kd[l] * km;
+            kb[l] = (1.0f - w.F0b[l]) * Kd[l] * km;
+        }
+    }
+    // The two lobes, times occlusion.
+    for (int l = 0; l < N; ++l) {
         const float occ = m.occlusion[l];
-        const float dr = kr * m.ar[l] * Er[l] * occ, dg = kg * m.ag[l] * Eg[l] * occ, db = kb * m.ab[l] * Eb[l] * occ;
-        const float spr = sr * Pr[l] * occ, spg = sg * Pg[l] * occ, spb = sb * Pb[l] * occ;
+        const float dr = kr[l] * m.ar[l] * Er[l] * occ, dg = kg[l] * m.ag[l] * Eg[l] * occ;
+        const float db = kb[l] * m.ab[l] * Eb[l] * occ;
+        const float spr = sr[l] * Pr[l] * occ, spg = sg[l] * Pg[l] * occ, spb = sb[l] * Pb[l] * occ;
         out.r[l] += dr + spr;
         out.g[l] += dg + spg;
         out.b[l] += db + spb;
