@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "scene/image.h"
+#include "shading/resolve.h"
 
 namespace prast {
 
@@ -187,10 +188,23 @@ ShadingContext SceneRenderer::shading_context(const FrameSettings& s) {
     return ctx;
 }
 
-void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb) {
+BackgroundFill frame_background(const FrameSettings& s, const Environment* env, int width, int height) {
+    const bool lit = s.view == DebugView::None || s.view == DebugView::Tiles;
+    return BackgroundFill(s.camera, width, height, env, lit ? s.background : Background::Black, s.background_color);
+}
+
+void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out) {
     const ShadingContext ctx = shading_context(s);
-    renderer_.clear(fb, 0.0f, 0.0f, 0.0f, 1.0f);
     renderer_.begin_frame();
+    // Cleared in the tile pass: alpha 1, depth 1, and the background's colour
+    // (black unless an environment or a colour is shown), so that samples no
+    // triangle covers resolve to the background.
+    FrameOptions frame;
+    frame.samples = s.samples;
+    frame.visibility = s.visibility;
+    const BackgroundFill background = frame_background(s, ctx.env, fb.width, fb.height);
+    background.attach(frame);
+    renderer_.begin(fb, frame);
     const float aspect = float(fb.width) / float(fb.height);
     const glm::mat4 vp = s.camera.view_projection(aspect);
     static const Material kFallback;
@@ -209,17 +223,42 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb) {
         prog.far_plane = s.camera.far_plane;
         DrawState st;
         st.cull = bm->m->double_sided ? CullMode::None : CullMode::Back;
+        st.may_discard = bm->m->alpha_mode == AlphaMode::Mask;  // shaded in order: discards decide visibility
         if (s.view == DebugView::Overdraw) {
             st.blend = Blend::Add;
             st.depth_test = false;
             st.depth_write = false;
         }
-        renderer_.draw(fb, prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(), mesh.indices.size(), st);
+        renderer_.submit(prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(), mesh.indices.size(), st);
     }
-    if (s.view == DebugView::None || s.view == DebugView::Tiles)
-        draw_background(fb, s.camera, ctx.env, s.background, s.background_color, renderer_.pool());
+    // The 8-bit image: from each finished tile, unless a whole-image overlay
+    // comes first (then after it, rows in parallel).
+    const bool overlay = s.view == DebugView::Overdraw || s.view == DebugView::Tiles;
+    TileResolve resolve;
+    if (out) {
+        resolve.rgba8 = out->rgba8;
+        resolve.width = fb.width;
+        resolve.exposure = out->exposure;
+        resolve.tonemap = out->tonemap;
+        resolve.raw = out->raw;
+    }
+    if (out && !overlay) renderer_.end(resolve);
+    else renderer_.end();
     if (s.view == DebugView::Overdraw) apply_overdraw_heat(fb);
     if (s.view == DebugView::Tiles) apply_tile_overlay(fb, renderer_.tile_entries(), renderer_.tile_size());
+    if (out && overlay) {
+        constexpr int kRows = 16;
+        renderer_.pool().run((fb.height + kRows - 1) / kRows, [&](int chunk, int) {
+            TileView v;
+            v.x0 = 0;
+            v.y0 = chunk * kRows;
+            v.width = fb.width;
+            v.height = std::min(kRows, fb.height - v.y0);
+            v.rgba = &fb.color[std::size_t(v.y0) * std::size_t(fb.width) * 4];
+            v.row = std::size_t(fb.width) * 4;
+            resolve(v);
+        });
+    }
 }
 
 // Fragments per pixel (in red, counted additively) to a heat ramp:

@@ -17,6 +17,7 @@
 #include "scene/scene.h"
 #include "shading/surface.h"
 #include "shading/texture.h"
+#include "shading/tonemap.h"
 
 namespace prast {
 
@@ -37,6 +38,18 @@ struct FrameSettings {
     // Env and Blur need an environment (without one they draw black).
     Background background = Background::Env;
     glm::vec3 background_color{0.0f};
+    int samples = 1;  // per pixel: 1, 2, 4 or 8 (README "Anti-aliasing")
+    // Where the visibility pass runs (the bytes are the same either way).
+    FrameOptions::Visibility visibility = FrameOptions::Visibility::Auto;
+};
+
+// The 8-bit image a frame writes from its tile pass (render's PNG): exposure,
+// tone map, sRGB, 8 bits; or, for data views, the values as they are.
+struct ImageOutput {
+    std::uint8_t* rgba8 = nullptr;  // framebuffer width * height * 4 bytes
+    float exposure = 1.0f;
+    ToneMap tonemap = ToneMap::Aces;
+    bool raw = false;               // resolve_raw8 instead (data debug views)
 };
 
 // Scene lights (KHR_lights_punctual) in shading form.
@@ -52,9 +65,11 @@ public:
     // decoded is dropped with a warning (the factor alone is used).
     SceneRenderer(const Scene& scene, Renderer& renderer);
 
-    // Renders one frame into fb (resized by the caller): clears to black,
-    // draws every mesh, and applies the overdraw/tiles debug overlays.
-    void render(const FrameSettings& settings, Framebuffer& fb);
+    // Renders one frame into fb (resized by the caller): clears to the
+    // background (frame_background), draws every mesh, and applies the
+    // overdraw/tiles debug overlays. With `out`, also writes the 8-bit image
+    // (in the tile pass, on every thread).
+    void render(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out = nullptr);
 
     // The environment a frame with these settings is lit by (null: none).
     const Environment* environment(const FrameSettings& settings);
@@ -78,6 +93,10 @@ private:
     std::unique_ptr<Environment> scene_env_;   // from Scene::environment, on first use
     std::unique_ptr<DfgTable> dfg_[3];         // by DfgModel, on first use
 };
+
+// The background a frame with these settings clears to: settings.background
+// for the lit image and the tiles view, black for the other debug views.
+BackgroundFill frame_background(const FrameSettings& settings, const Environment* env, int width, int height);
 
 // Debug-view post passes, exposed for tests.
 void apply_overdraw_heat(Framebuffer& fb);

@@ -87,6 +87,7 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     s.energy = opt.energy;
     s.background = opt.background;
     s.background_color = opt.background_color;
+    s.samples = opt.samples;
 
     // Frame 0 of render's turntable loop.
     Camera cam = camera;
