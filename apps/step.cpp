@@ -42,7 +42,7 @@ const char* step_usage() {
 "  --size WxH --eye X,Y,Z --target X,Y,Z --up X,Y,Z --fov DEG --near N --far F\n"
 "  --sun X,Y,Z:R,G,B --point X,Y,Z:R,G,B --ambient R,G,B --no-default-lights\n"
 "  --brdf default|gltf --exposure E --tonemap none|aces|neutral --msaa N\n"
-"  --threads N --tile N\n"
+"  --threads N --tile N --shadows on|off --shadow-size N\n"
 "  --help, --version    exit codes: 0 ok, 1 bad file or a failed command, 2 bad usage\n";
 }
 
@@ -117,6 +117,10 @@ int run(int argc, char** argv) {
         std::printf("step (prast) %s\n", kRenderVersion);
         return 0;
     }
+    if (opt.ibl == IblMode::Reference) {
+        std::fprintf(stderr, "step: --ibl reference: step explains the split sum (render --pixel prints the reference)\n");
+        return kExitUsage;
+    }
     if (opt.pixel && (so.serve || !so.out_dir.empty())) {
         std::fprintf(stderr, "step: --pixel: not with --out or --serve\n");
         return kExitUsage;
@@ -136,11 +140,18 @@ int run(int argc, char** argv) {
     req.ambient = opt.ambient;
     req.no_default_lights = opt.no_default_lights;
     req.brdf = opt.brdf;
+    req.env = opt.env;
+    req.env_intensity = opt.env_intensity;
+    req.env_rotate_deg = opt.env_rotate_deg;
+    req.background = opt.background;
+    req.background_color = opt.background_color;
+    req.energy = opt.energy;
     req.exposure = opt.exposure;
     req.tonemap = opt.effective_tonemap();
     req.threads = opt.threads;
     req.tile_size = opt.tile_size;
     req.samples = opt.msaa;
+    req.shadows = opt.shadows;
 
     StepScene scene;
     SetupError setup_err;

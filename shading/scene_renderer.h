@@ -9,7 +9,10 @@
 
 #include "raster/pipeline.h"
 #include "scene/camera.h"
+#include "shading/background.h"
 #include "shading/debug_view.h"
+#include "shading/dfg.h"
+#include "shading/environment.h"
 #include "shading/pbr_program.h"
 #include "scene/scene.h"
 #include "shading/shadow_pass.h"
@@ -25,7 +28,18 @@ struct FrameSettings {
     glm::vec3 ambient{0.03f};
     BrdfModel model = BrdfModel::Default;
     DebugView view = DebugView::None;
-    ShadowSettings shadows;  // shadow maps for every light (off by default; render turns them on)
+    ShadowSettings shadows;  // shadow maps for the lights (README "Shadows"); not for the environment
+    // Image-based lighting: this environment, or when null the scene's own
+    // (Scene::environment, prefiltered on first use) unless scene_environment
+    // is false. With one, it replaces the ambient term.
+    const Environment* environment = nullptr;
+    bool scene_environment = true;
+    IblMode ibl = IblMode::SplitSum;
+    int ibl_samples = 256;
+    bool energy = false;   // --energy conserve
+    // Env and Blur need an environment (without one they draw black).
+    Background background = Background::Env;
+    glm::vec3 background_color{0.0f};
     int samples = 1;  // per pixel: 1, 2, 4 or 8 (README "Anti-aliasing")
     // Where the visibility pass runs (the bytes are the same either way).
     FrameOptions::Visibility visibility = FrameOptions::Visibility::Auto;
@@ -53,14 +67,24 @@ public:
     // decoded is dropped with a warning (the factor alone is used).
     SceneRenderer(const Scene& scene, Renderer& renderer);
 
-    // Renders one frame into fb (resized by the caller): clears to black,
-    // draws every mesh, and applies the overdraw/tiles debug overlays. With
-    // `out`, also writes the 8-bit image (in the tile pass, on every thread).
+    // Renders one frame into fb (resized by the caller): clears to the
+    // background (frame_background), draws every mesh, and applies the
+    // overdraw/tiles debug overlays. With `out`, also writes the 8-bit image
+    // (in the tile pass, on every thread).
     void render(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out = nullptr);
 
-    // The frame's lights, each pointing at its shadow map drawn for these
-    // settings (valid until the next call); the lights as they are when
-    // shadows are off or the view shows no lighting. render() calls it.
+    // The environment a frame with these settings is lit by (null: none).
+    const Environment* environment(const FrameSettings& settings);
+    // A DFG table, built on the renderer's pool on first use.
+    const DfgTable& dfg_table(DfgModel model);
+    // The context render() shades with (lights, eye, environment, tables).
+    // With settings.shadows on and the aspect of the frame (width / height),
+    // each light points at its shadow map, drawn for these settings unless
+    // the last ones drawn are for the same camera, lights and size.
+    ShadingContext shading_context(const FrameSettings& settings, float aspect = 0.0f);
+    // The frame's lights, each pointing at its shadow map (valid until maps
+    // for other settings are drawn); the lights as they are when shadows are
+    // off, the aspect is 0 or the view shows no lighting.
     std::vector<ShadingLight> shadowed_lights(const FrameSettings& settings, float aspect);
     const ShadowMaps& shadow_maps() const { return shadow_maps_; }
 
@@ -77,7 +101,14 @@ private:
     std::vector<BoundMaterial> bound_;
     std::vector<std::string> warnings_;
     ShadowMaps shadow_maps_;
+    std::vector<float> shadow_key_;  // what the maps were drawn for (shadowed_lights)
+    std::unique_ptr<Environment> scene_env_;   // from Scene::environment, on first use
+    std::unique_ptr<DfgTable> dfg_[3];         // by DfgModel, on first use
 };
+
+// The background a frame with these settings clears to: settings.background
+// for the lit image and the tiles view, black for the other debug views.
+BackgroundFill frame_background(const FrameSettings& settings, const Environment* env, int width, int height);
 
 // Debug-view post passes, exposed for tests.
 void apply_overdraw_heat(Framebuffer& fb);

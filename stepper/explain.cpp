@@ -462,23 +462,25 @@ PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, 
     px.y = y;
     px.samples = rec.samples;
     const int S = rec.samples;
-    const ShadingContext ctx = shading_context(s.settings);
+    const ShadingContext ctx = shading_context(s);
     const TileRecord& tile = rec.tiles[std::size_t(rec.tile_of(x, y))];
     const int bx = x & ~(kBlockSize - 1), by = y & ~(kBlockSize - 1);
     for (int l = 0; l < kBlockLanes; ++l)
         if (lane_x(l) == x - bx && lane_y(l) == y - by) px.lane = l;
     const int lane = px.lane;
-    // The tile pass, sample by sample: cleared, then each fragment in the
-    // tile's order. A draw taking the visibility pass writes depth and makes
-    // the fragment the sample's winner (`pending`), shaded once later; a draw
-    // shaded in order writes its colour at once.
+    // The tile pass, sample by sample: cleared (to the background), then each
+    // fragment in the tile's order. A draw taking the visibility pass writes
+    // depth and makes the fragment the sample's winner (`pending`), shaded
+    // once later; a draw shaded in order writes its colour at once.
+    px.background = frame_background(s, rec.fb.width, rec.fb.height).at(x, y);
     for (int i = 0; i < S; ++i) {
         px.sample_depth[i] = 1.0f;
-        px.sample_color[i] = glm::vec3(0.0f);
+        px.sample_color[i] = px.background;
         px.sample_owner[i] = -1;
     }
     int pending[kMaxSamples];
     for (int i = 0; i < S; ++i) pending[i] = -1;
+    int blends = 0;
     for (const BlockRecord& b : tile.blocks) {
         if (b.bx != bx || b.by != by || !(b.mask & (1u << lane))) continue;
         HistoryEntry h;
@@ -501,6 +503,20 @@ PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, 
         replay_block(s, rec, b, h.replay);
         if (h.shaded) h.shading = shade_lane(ctx, material_of(s, rec, tri), h.replay, lane);
         const int index = int(px.history.size());
+        const bool blend = d.state.blend == Blend::Alpha && h.written && h.pass;
+        if (blend) {
+            h.blend_order = ++blends;
+            h.alpha = h.shading.ms.alpha;
+            // A blending draw reads the colour: the visibility pass's winners
+            // so far are shaded first (raster/frame.h).
+            for (int i = 0; i < S; ++i) {
+                if (pending[i] < 0 || !((h.pass >> i) & 1u)) continue;
+                const HistoryEntry& w = px.history[std::size_t(pending[i])];
+                px.sample_owner[i] = pending[i];
+                px.sample_color[i] = w.written ? w.shading.Lo : glm::vec3(0.0f);
+                pending[i] = -1;
+            }
+        }
         for (int i = 0; i < S; ++i) {
             if (!((h.pass >> i) & 1u)) continue;
             if (h.visible) {
@@ -508,7 +524,16 @@ PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, 
                 pending[i] = index;
             } else if (h.written) {
                 if (d.state.depth_write) px.sample_depth[i] = h.z[i];
-                px.sample_color[i] = h.shading.Lo;
+                if (blend) {
+                    // raster/shade.h write_color(), Blend::Alpha: out * a + dst * (1 - a).
+                    const float a = h.alpha, keep = 1.0f - a;
+                    const glm::vec3 src = h.shading.Lo, dst = px.sample_color[i];
+                    px.sample_color[i] = glm::vec3(src.r * a + dst.r * keep, src.g * a + dst.g * keep,
+                                                   src.b * a + dst.b * keep);
+                    h.blended[i] = px.sample_color[i];
+                } else {
+                    px.sample_color[i] = h.shading.Lo;
+                }
                 px.sample_owner[i] = index;
                 pending[i] = -1;
             }
@@ -596,7 +621,16 @@ void shading_text(std::ostringstream& o, const StepScene& s, const Recording& re
         const ShadingLight& src = s.settings.lights[i];
         const BrdfTerms& t = L.terms;
         o << "  light " << i << " (" << (src.point ? "point" : "sun") << "): l " << vec(L.l) << " radiance "
-          << vec(L.radiance) << "\n";
+          << vec(L.radiance) << (L.shadowed ? " (times the shadow's visibility)" : "") << "\n";
+        if (L.shadowed) {
+            const ShadowTap& tp = L.shadow.tap;
+            o << "    shadow map: " << (src.point ? "cube face " + std::to_string(tp.face) + " " : std::string())
+              << "texel (" << num(tp.u) << ", " << num(tp.v) << "), distance to the light " << num(tp.receiver)
+              << ", map depth " << (tp.inside ? num(L.shadow.map_distance) : std::string("(outside the map: lit)"))
+              << ", bias " << num(tp.bias) << "\n";
+            o << "    PCF: 3x3 bilinear taps (4x4 texels, weights 1-f,1,1,f; f " << num(tp.fx) << ", " << num(tp.fy)
+              << "), lit where depth >= " << num(tp.threshold) << ": visibility " << num(L.shadow.visibility) << "\n";
+        }
         o << "    h " << vec(L.h) << "  n.l " << num(t.NoL) << "  n.v " << num(t.NoV) << "  n.h " << num(t.NoH)
           << "  v.h " << num(t.VoH) << "\n";
         o << "    D " << num(t.D) << "  " << (s.settings.model == BrdfModel::Gltf ? "V " : "G ") << num(t.G) << "  F "
@@ -605,8 +639,19 @@ void shading_text(std::ostringstream& o, const StepScene& s, const Recording& re
         o << "    contribution (diffuse + specular) * radiance * n.l = " << vec(L.contribution) << "\n";
     }
     o << "  emissive " << vec(ms.emissive) << "\n";
-    o << "  ambient " << vec(s.settings.ambient) << " * albedo * occlusion = " << vec(sh.ambient) << "\n";
-    o << "  shaded colour (emissive + contributions + ambient) " << vec(sh.Lo) << "\n";
+    if (sh.ibl) {
+        const IblTerms& t = sh.ibl_terms;
+        o << "  environment (split sum): irradiance E(n)/pi " << vec(t.irradiance) << ", kd " << vec(t.kd)
+          << " -> diffuse " << vec(t.diffuse) << "\n";
+        o << "    prefiltered " << vec(t.prefiltered) << " along " << vec(t.R) << " at level " << num(t.level)
+          << ", dfg scale " << num(t.dfg_scale) << " bias " << num(t.dfg_bias) << " (n.v " << num(t.NoV)
+          << ") -> specular " << vec(t.specular) << "\n";
+        o << "    occlusion " << num(t.occlusion) << "; diffuse + specular = " << vec(sh.ambient) << "\n";
+    } else {
+        o << "  ambient " << vec(s.settings.ambient) << " * albedo * occlusion = " << vec(sh.ambient) << "\n";
+    }
+    o << "  shaded colour (emissive + contributions + " << (sh.ibl ? "environment" : "ambient") << ") "
+      << vec(sh.Lo) << "\n";
     if (!sh.matches_shade_surface) o << "  NOTE: shade_surface() gives a different value\n";
 }
 
@@ -641,7 +686,7 @@ std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExpl
             o << " s" << i << " (" << num(pattern.pixel_x(i)) << ", " << num(pattern.pixel_y(i)) << ")";
         o << "\n";
     }
-    o << "history: cleared to (0, 0, 0) depth 1, then " << px.history.size() << " fragment"
+    o << "history: cleared to " << vec(px.background) << " depth 1, then " << px.history.size() << " fragment"
       << (px.history.size() == 1 ? "" : "s") << " in submission order\n";
     for (std::size_t i = 0; i < px.history.size(); ++i) {
         const HistoryEntry& h = px.history[i];
@@ -690,6 +735,13 @@ std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExpl
         } else if (h.killed) {
             o << "     shaded in order (alpha mask): discarded by the shader (alpha " << num(h.shading.ms.alpha)
               << " below the cutoff)\n";
+        } else if (h.shaded && h.blend_order) {
+            o << "     shaded in order (alpha blend, back to front; depth tested, not written): blend #"
+              << h.blend_order << ", shader out " << vec(h.shading.Lo) << " alpha " << num(h.alpha) << "\n";
+            for (int k = 0; k < S; ++k)
+                if ((h.pass >> k) & 1u)
+                    o << "     " << (S > 1 ? "sample " + std::to_string(k) + ": " : std::string())
+                      << "out * alpha + previous * (1 - alpha) = " << vec(h.blended[k]) << "\n";
         } else if (h.shaded) {
             o << "     shaded in order (" << (d.state.may_discard ? "alpha mask" : "no visibility pass")
               << "): shader out " << vec(h.shading.Lo) << ", written to sample" << (__builtin_popcount(h.pass) > 1 ? "s " : " ")
@@ -709,7 +761,7 @@ std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExpl
         o << "resolve: the average of the " << S << " samples (summed pairwise) = " << vec(px.linear) << "\n";
     }
     if (px.contributors.empty()) {
-        o << "no fragment was written: the background\n";
+        o << "no fragment was written: the background " << vec(px.background) << "\n";
     } else {
         for (int k : px.contributors) {
             const HistoryEntry& w = px.history[std::size_t(k)];
@@ -733,6 +785,7 @@ json pixel_json(const StepScene& s, const Recording& rec, const PixelExplanation
     j["x"] = px.x;
     j["y"] = px.y;
     j["samples"] = px.samples;
+    j["background"] = j3(px.background);
     json hist = json::array();
     for (const HistoryEntry& h : px.history) {
         json e;

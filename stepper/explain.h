@@ -44,6 +44,9 @@ struct HistoryEntry {
     bool shaded = false;          // the fragment program ran for it (once for the pixel)
     bool written = false, killed = false;  // its colour was written / it was discarded
     std::uint32_t owns = 0;       // bit s: sample s ends the frame with its colour
+    int blend_order = 0;          // alpha BLEND: 1 for the pixel's first blended fragment, 2 ...; 0 otherwise
+    float alpha = 1.0f;           // alpha BLEND: the weight of its colour
+    glm::vec3 blended[kMaxSamples] = {};  // alpha BLEND: each written sample's colour after blending
     ReplayedBlock replay;
     LaneShading shading;          // only when shaded
 };
@@ -55,6 +58,7 @@ struct PixelExplanation {
     int sample_owner[kMaxSamples];         // history index whose colour sample s holds; -1: cleared
     glm::vec3 sample_color[kMaxSamples];   // each sample's final linear colour
     float sample_depth[kMaxSamples];
+    glm::vec3 background{0.0f};            // what every sample clears to: render's background here
     std::vector<int> contributors;         // history indices owning samples, most samples first
     glm::vec3 linear{0.0f};       // the resolve of the samples: what render --output .hdr writes
     glm::vec3 framebuffer{0.0f};  // the recorded frame's value (equal to linear, or a NOTE says so)

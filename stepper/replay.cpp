@@ -152,6 +152,11 @@ LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const
     for (const ShadingLight& L : ctx.lights) {
         LightStep st;
         light_at(L, r.sp.P, in.l, st.radiance);
+        if (L.shadow) {
+            st.shadowed = true;
+            st.shadow = shadow_probe(*L.shadow, r.sp.P, r.ms.N_geom, L.direction);
+        }
+        st.radiance *= light_visibility(L, r.sp.P, r.ms.N_geom);
         st.l = in.l;
         const glm::vec3 sum = in.l + in.v;  // evaluate_brdf()'s half vector, for display
         const float len2 = glm::dot(sum, sum);
@@ -161,7 +166,13 @@ LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const
         Lo += st.contribution;
         r.lights.push_back(st);
     }
-    r.ambient = ctx.ambient * r.ms.albedo * r.ms.occlusion;
+    r.ibl = ctx.env != nullptr;
+    if (r.ibl) {
+        r.ibl_terms = ibl_terms(r.ms, r.sp, ctx);
+        r.ambient = r.ibl_terms.diffuse + r.ibl_terms.specular;
+    } else {
+        r.ambient = ctx.ambient * r.ms.albedo * r.ms.occlusion;
+    }
     Lo += r.ambient;
     r.Lo = Lo;
     const glm::vec3 ref = shade_surface(r.ms, r.sp, ctx);

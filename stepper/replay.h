@@ -58,7 +58,9 @@ void replay_block(const StepScene& s, const Recording& rec, const BlockRecord& b
 
 // One lane's shading, step by step, as shade_surface() computes it.
 struct LightStep {
-    glm::vec3 l{0.0f}, h{0.0f}, radiance{0.0f};
+    glm::vec3 l{0.0f}, h{0.0f}, radiance{0.0f};  // radiance after the shadow's visibility
+    bool shadowed = false;              // the light has a shadow map: `shadow` holds its lookup
+    ShadowProbe shadow;
     BrdfTerms terms;
     glm::vec3 contribution{0.0f};       // f * radiance * n.l
 };
@@ -69,7 +71,9 @@ struct LaneShading {
     bool killed = false;                // alpha MASK discarded it
     BrdfInputs inputs;
     std::vector<LightStep> lights;
-    glm::vec3 ambient{0.0f};            // ambient * albedo * occlusion
+    glm::vec3 ambient{0.0f};            // ambient * albedo * occlusion, or the environment's split sum
+    bool ibl = false;                   // lit by an environment: ambient = ibl_terms.diffuse + .specular
+    IblTerms ibl_terms;
     glm::vec3 Lo{0.0f};                 // the colour the shader wrote
     bool matches_shade_surface = true;  // Lo == shade_surface(): always, or the stepper is wrong
 };

@@ -30,11 +30,17 @@ struct FrameRequest {
     glm::vec3 ambient{0.03f};
     bool no_default_lights = false;
     BrdfModel brdf = BrdfModel::Default;
+    std::string env;                         // --env FILE.hdr; empty: the scene's own, if any
+    float env_intensity = 1.0f, env_rotate_deg = 0.0f;
+    Background background = Background::Env;
+    glm::vec3 background_color{0.0f};
+    bool energy = false;                     // --energy conserve
     float exposure = 1.0f;
     ToneMap tonemap = ToneMap::Aces;         // render's effective tone map
     int threads = 0;
     int tile_size = kDefaultTileSize;
     int samples = 1;                         // per pixel (render's --msaa)
+    ShadowSettings shadows;                  // render's --shadows, --shadow-size
 };
 
 // A scene ready to draw: loaded, framed, lit, its textures bound.
@@ -44,6 +50,7 @@ struct StepScene {
     FrameSettings settings;          // camera (frame 0), lights, ambient, BRDF
     std::unique_ptr<Renderer> renderer;
     std::unique_ptr<SceneRenderer> scene_renderer;
+    std::unique_ptr<Environment> environment;  // prefiltered as render does, when there is one
     std::vector<std::string> notes;  // warnings and the default-rig note, for stderr
     int width() const { return options.width; }
     int height() const { return options.height; }
