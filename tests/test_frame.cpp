@@ -234,6 +234,73 @@ TEST_CASE("visibility: a single opaque draw shades each covered pixel exactly on
     CHECK(r.stats().fragments_written > covered);
 }
 
+namespace {
+// Per pixel: the last triangle whose depth test passed there (from
+// fragments(), in order) and the triangle shaded there (from shaded()).
+struct WinnerObserver {
+    static constexpr bool enabled = true;
+    int W, H;
+    std::mutex m;
+    std::vector<std::int64_t> last_pass, shaded_prim;
+    std::vector<int> shaded_count;
+    bool order_broken = false;
+    std::vector<std::int64_t> last_seen;
+    WinnerObserver(int w, int h)
+        : W(w), H(h), last_pass(std::size_t(w) * h, -1), shaded_prim(std::size_t(w) * h, -1),
+          shaded_count(std::size_t(w) * h, 0), last_seen(std::size_t(w) * h, -1) {}
+    void vertex(std::uint32_t, const float*, const float*, int) {}
+    void triangle(std::uint32_t, TriangleFate, bool, const TriangleSetup*) {}
+    void binned(std::uint32_t, int) {}
+    void fragments(std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass, const float*) {
+        std::lock_guard<std::mutex> lock(m);
+        for (int l = 0; l < kBlockLanes; ++l) {
+            const std::size_t p = std::size_t(by + lane_y(l)) * std::size_t(W) + std::size_t(bx + lane_x(l));
+            if (mask & (1u << l)) {
+                order_broken |= std::int64_t(prim) < last_seen[p];
+                last_seen[p] = prim;
+            }
+            if (pass & (1u << l)) last_pass[p] = prim;
+        }
+    }
+    template <int NV>
+    void shaded(const FragmentBlock<NV>& in, const FragmentOut&, std::uint32_t live) {
+        std::lock_guard<std::mutex> lock(m);
+        for (int l = 0; l < kBlockLanes; ++l)
+            if (live & (1u << l)) {
+                const std::size_t p = std::size_t(in.y + lane_y(l)) * std::size_t(W) + std::size_t(in.x + lane_x(l));
+                shaded_prim[p] = in.prim_id;
+                ++shaded_count[p];
+            }
+    }
+};
+} // namespace
+
+TEST_CASE("observer: through the visibility pass every fragment comes in order, each winner is shaded once") {
+    const OverdrawScene sc(150, 110, 21, false);
+    const Draw& d = sc.draws[0];
+    for (int threads : {1, 3}) {
+        CAPTURE(threads);
+        Renderer r({threads, 32});
+        Framebuffer fb(sc.W, sc.H);
+        WinnerObserver obs(sc.W, sc.H);
+        PaintProgram p{sc.clip.data(), sc.var.data(), false, 1.0f};
+        r.begin_frame();
+        r.begin(fb, frame_options(FrameOptions::Visibility::Always));
+        r.submit(p, std::uint32_t(sc.clip.size()), d.idx.data(), d.idx.size(), d.state, obs);
+        r.end();
+        CHECK(!obs.order_broken);
+        int wrong = 0, shaded = 0;
+        for (std::size_t i = 0; i < obs.last_pass.size(); ++i) {
+            wrong += obs.shaded_prim[i] != obs.last_pass[i];
+            wrong += obs.shaded_count[i] > 1;
+            shaded += obs.shaded_count[i];
+        }
+        CHECK(wrong == 0);
+        CHECK(std::uint64_t(shaded) == r.stats().fragments_shaded);
+        CHECK(r.stats().fragments_written > std::uint64_t(shaded));
+    }
+}
+
 TEST_CASE("blend: alpha over a known background is src * a + dst * (1 - a), depth tested, not written") {
     const int W = 32, H = 32;
     // An opaque quad in the left half at z_ndc 0 (window depth 0.5), then a
