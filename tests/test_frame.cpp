@@ -8,12 +8,15 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <mutex>
 #include <stdexcept>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "shading/resolve.h"
+#include "shading/tonemap.h"
 #include "tests/raster_test_util.h"
 
 using namespace prast;
@@ -413,6 +416,75 @@ TEST_CASE("frame: the tile hook sees every pixel once, with its final colour") {
             CHECK(seen == fb.color);
         }
     }
+}
+
+TEST_CASE("frame: tiles no draw reaches hold the resolved clear value and are handed over as uniform") {
+    // One small triangle in the top-left corner: most 16x16 tiles are never
+    // reached. Such a tile is cleared in the framebuffer directly (no samples)
+    // and converted to 8 bits from one pixel; the values must be what the
+    // sample clear and resolve give: the pairwise mean of S equal values,
+    // which is the value itself unless the sums overflow (3e38 below).
+    const int W = 150, H = 97;
+    const std::vector<glm::vec4> clip = {at(3, 2, W, H), at(30, 5, W, H), at(9, 28, W, H)};
+    const std::vector<float> var = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const std::vector<std::uint32_t> idx = {0, 1, 2};
+    const float clears[2][4] = {{0.25f, 0.5f, 0.125f, 1.0f}, {0.25f, 3e38f, -0.0f, 0.75f}};
+    for (const float* clear : clears)
+        for (int samples : {1, 2, 4, 8}) {
+            CAPTURE(samples);
+            CAPTURE(clear[1]);
+            float want[4];
+            for (int k = 0; k < 4; ++k) {
+                float v[8];
+                for (int s = 0; s < samples; ++s) v[s] = clear[k];
+                for (int n = samples; n > 1; n /= 2)
+                    for (int i = 0; i < n / 2; ++i) v[i] = v[2 * i] + v[2 * i + 1];
+                want[k] = samples == 1 ? clear[k] : v[0] * (1.0f / float(samples));
+            }
+            CHECK(std::isinf(want[1]) == (clear[1] > 1e30f && samples > 1));
+            Renderer r({3, 16});
+            Framebuffer fb(W, H);
+            FrameOptions o = frame_options(FrameOptions::Visibility::Auto, samples);
+            for (int k = 0; k < 4; ++k) o.clear_color[k] = clear[k];
+            o.clear_depth = 0.75f;
+            std::vector<std::uint8_t> tiles(std::size_t(W) * H * 4, 7), whole(tiles.size(), 9);
+            TileResolve resolve;
+            resolve.rgba8 = tiles.data();
+            resolve.width = W;
+            int uniform_tiles = 0, wrong_uniform = 0;
+            std::mutex m;
+            PaintProgram p{clip.data(), var.data(), false, 1.0f};
+            r.begin(fb, o);
+            DrawState st;
+            st.cull = CullMode::None;
+            r.submit(p, 3, idx.data(), idx.size(), st);
+            r.end([&](const TileView& v) {
+                resolve(v);
+                std::lock_guard<std::mutex> lock(m);
+                if (!v.uniform) return;
+                ++uniform_tiles;
+                for (int y = 0; y < v.height; ++y)
+                    for (int x = 0; x < v.width; ++x)
+                        for (int c = 0; c < 4; ++c)
+                            wrong_uniform += std::memcmp(&v.rgba[std::size_t(y) * v.row + 4 * std::size_t(x) + std::size_t(c)], &v.rgba[c], sizeof(float)) != 0;
+            });
+            CHECK(uniform_tiles > 40);
+            CHECK(wrong_uniform == 0);
+            int drawn = 0, wrong = 0;
+            for (int y = 0; y < H; ++y)
+                for (int x = 0; x < W; ++x) {
+                    const float* px = fb.pixel(x, y);
+                    if (fb.depth[std::size_t(y) * W + std::size_t(x)] != 0.75f) {
+                        ++drawn;
+                        continue;
+                    }
+                    for (int c = 0; c < 4; ++c) wrong += std::memcmp(&px[c], &want[c], sizeof(float)) != 0;
+                }
+            CHECK(drawn > 200);
+            CHECK(wrong == 0);
+            resolve_to_srgb8(fb.color.data(), W, H, 1.0f, ToneMap::Aces, whole.data());
+            CHECK(tiles == whole);
+        }
 }
 
 TEST_CASE("frame: misuse is refused") {
