@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 
 #if defined(__AVX2__)
@@ -224,14 +225,15 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     tg.wox = r.x0;
     tg.woy = r.y0;
 
-    // A tile no draw reaches keeps its cleared colour and depth.
+    // A tile no draw reaches keeps its cleared colour and depth (one colour
+    // unless a fill paints a background).
     bool reached = false;
     for (const std::unique_ptr<detail::DrawRecord>& dp : draws_)
         for (int j = dp->first_job; j < dp->first_job + dp->job_count && !reached; ++j) {
             const BinJob& job = jobs_[std::size_t(j)];
             reached = job.tile_offsets[std::size_t(tile)] != job.tile_offsets[std::size_t(tile) + 1];
         }
-    const bool uniform = options_.clear && !reached;
+    const bool uniform = options_.clear && !options_.clear_fill && !reached;
     // Several samples all cleared to one value resolve to exactly that value
     // (resolve.cpp: pairwise sums of equal values, times 1/S), unless the
     // sums overflow: such a tile is cleared in the framebuffer directly.
@@ -245,6 +247,23 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     if (options_.clear) {
         if (direct) clear_tile(fb, r, options_.clear_color, options_.clear_depth);
         else clear_samples(tg.color, tg.depth, T, S, options_.clear_color, options_.clear_depth);
+        if (options_.clear_fill && tg.color) {
+            if (S == 1) {
+                options_.clear_fill(options_.clear_user, r.x0, r.y0, r.width(), r.height(),
+                                    &fb.color[(std::size_t(r.y0) * std::size_t(fb.width) + std::size_t(r.x0)) * 4],
+                                    std::size_t(fb.width) * 4);
+            } else {
+                // Plane 0, then the same pixels into every other sample's plane.
+                const std::size_t plane = std::size_t(T) * std::size_t(T) * 4;
+                options_.clear_fill(options_.clear_user, r.x0, r.y0, r.width(), r.height(), tg.color,
+                                    std::size_t(T) * 4);
+                for (int s = 1; s < S; ++s)
+                    for (int y = 0; y < r.height(); ++y)
+                        std::memcpy(tg.color + s * plane + std::size_t(y) * std::size_t(T) * 4,
+                                    tg.color + std::size_t(y) * std::size_t(T) * 4,
+                                    std::size_t(r.width()) * 4 * sizeof(float));
+            }
+        }
     } else if (S > 1) {
         load_samples(fb, r, tg.color, tg.depth, T, S);
     }
