@@ -193,6 +193,10 @@ def traversal_checks(port):
         status, headers, body = request(port, path)
         assert status == 200 and headers["content-type"] == mime and len(body) > 100, (path, status, headers)
         assert headers["x-content-type-options"] == "nosniff"
+        # Text from the model (mesh and material names) is shown as text:
+        # the page never builds HTML from strings.
+        for sink in (b"innerHTML", b"outerHTML", b"insertAdjacentHTML", b"document.write", b"eval(", b"Function("):
+            assert sink not in body, (path, sink)
         if mime.startswith("text/html"):
             csp = headers["content-security-policy"]
             assert "default-src 'self'" in csp and "frame-ancestors 'none'" in csp, csp
