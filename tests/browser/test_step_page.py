@@ -11,7 +11,10 @@ requests (4xx JSON, the server still answering afterwards).
 usage: test_step_page.py STEP_EXE [--api]
 With --api, no browser: the JSON API only (every endpoint, the pixel text
 against the terminal front end's, and a bounded loop of malformed requests
-that must all get 4xx JSON errors while the server keeps answering).
+that must all get 4xx JSON errors while the server keeps answering), then
+the hostile-input checks of hostile_http.py (Host header, methods, bodies,
+traversal, numbers, malformed requests, limits, slow and concurrent
+clients, a seeded fuzz loop, 127.0.0.1 only).
 Without it, exit 77 (CTest: skipped) when chromium, chromedriver or
 python3-selenium is missing, unless PRAST_BROWSER_REQUIRED=1 (CI) makes
 that a failure.
@@ -23,10 +26,11 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 import urllib.error
 import urllib.parse
 import urllib.request
+
+import hostile_http
 
 SKIP = 77
 FLAGS = ["--size", "320x180", "--threads", "2"]
@@ -152,6 +156,8 @@ def api_checks(step):
         assert code == 200 and server.poll() is None
         print("api: every endpoint answers as the terminal front end does; %d malformed requests got 4xx JSON"
               % len(bad))
+        hostile_http.run(int(base.rsplit(":", 1)[1]), frame)
+        assert server.poll() is None
     finally:
         stop_server(server)
 
