@@ -79,6 +79,23 @@ bool host_allowed(const std::string& host, int port) {
     return name == "127.0.0.1" || equals_lower(name, "localhost");
 }
 
+// A request a browser made for another origin's page (an <img>, a form, a
+// fetch from a site, or from another server on this machine): browsers name
+// the page's origin in Origin and say in Sec-Fetch-Site whether it is ours.
+// Requests from our page or typed in the address bar pass; so do clients
+// that send neither (curl, scripts).
+bool cross_origin(const httplib::Request& req, int port) {
+    if (req.has_header("Origin")) {
+        const std::string origin = req.get_header_value("Origin"), p = ":" + std::to_string(port);
+        if (origin != "http://127.0.0.1" + p && origin != "http://localhost" + p) return true;
+    }
+    if (req.has_header("Sec-Fetch-Site")) {
+        const std::string site = req.get_header_value("Sec-Fetch-Site");
+        if (site != "same-origin" && site != "none") return true;
+    }
+    return false;
+}
+
 } // namespace
 
 int serve(Session& session, int port) {
@@ -194,6 +211,8 @@ int serve(Session& session, int port) {
     server.set_pre_routing_handler([bound](const httplib::Request& req, httplib::Response& res) {
         if (req.get_header_value_count("Host") != 1 || !host_allowed(req.get_header_value("Host"), bound)) {
             send_error(res, 403, "the Host header must be 127.0.0.1 or localhost (with this server's port)");
+        } else if (cross_origin(req, bound)) {
+            send_error(res, 403, "a request from another site's page");
         } else if (req.method != "GET" && req.method != "HEAD") {
             res.set_header("Allow", "GET, HEAD");
             send_error(res, 405, "read-only: only GET and HEAD");

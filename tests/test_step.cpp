@@ -290,6 +290,42 @@ TEST_CASE("--out: every stage as a PNG and an index.html; the final stage is ren
     CHECK(bad.err.find("afile") != std::string::npos);
 }
 
+TEST_CASE("stage wireframe: set-up triangles white, clipped pieces orange, culled dark blue, degenerate magenta") {
+    // The colours as stepper/stages.cpp writes them (linear * 255, no sRGB).
+    const std::uint8_t kWhite[3] = {255, 255, 255}, kOrange[3] = {255, 140, 26}, kBlue[3] = {38, 51, 153},
+                       kMagenta[3] = {255, 0, 255};
+    auto count = [](const Rgb8& img, const std::uint8_t* c) {
+        int n = 0;
+        for (std::size_t i = 0; i < img.rgb.size(); i += 3) n += std::memcmp(&img.rgb[i], c, 3) == 0;
+        return n;
+    };
+    CliSandbox box;
+    REQUIRE(run_step(box, {"--size", "320x180"}, "stage wireframe whole.png\n").code == 0);
+    REQUIRE(run_step(box, {"--size", "320x180", "--near", "6.5", "--far", "20"}, "stage wireframe cut.png\n").code == 0);
+    const Rgb8 whole = load_rgb8(box.path("whole.png")), cut = load_rgb8(box.path("cut.png"));
+    REQUIRE(!whole.empty());
+    REQUIRE(!cut.empty());
+    // Nothing is clipped in the built-in frame; the near plane through the
+    // floor clips some triangles, drawn in their own colour.
+    CHECK(count(whole, kOrange) == 0);
+    CHECK(count(cut, kOrange) > 100);
+    for (const Rgb8* img : {&whole, &cut}) {
+        CHECK(count(*img, kWhite) > 1000);
+        CHECK(count(*img, kBlue) > 0);     // back faces seen past the silhouettes
+        CHECK(count(*img, kMagenta) > 0);  // the scene's degenerate triangles
+    }
+}
+
+TEST_CASE("--out: names from the model reach index.html escaped") {
+    CliSandbox box;
+    write_text(box.work() / "<i>&x.obj", "o <script>alert(1)</script>\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const CliRun r = box.run_exe(kStep, {"--size", "32x18", "<i>&x.obj", "--out", "o"});
+    REQUIRE(r.code == 0);
+    const std::string index = read_text(box.work() / "o" / "index.html");
+    CHECK(index.find("<i>") == std::string::npos);
+    CHECK(index.find("&lt;i&gt;&amp;x.obj") != std::string::npos);
+}
+
 TEST_CASE("sessions: the built-in scene, step by step") {
     check_transcript("builtin", {});
 }

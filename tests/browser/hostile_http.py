@@ -3,7 +3,8 @@
 run(port) asserts, against a running server:
 - every bad request (malformed or oversized request lines and headers,
   out-of-range, negative, NaN, overflowing or repeated numbers, unknown
-  endpoints, bodies on GET, other methods, a foreign or missing Host header)
+  endpoints, bodies on GET, other methods, a foreign or missing Host header,
+  another site's Origin or Sec-Fetch-Site)
   gets a 4xx JSON {"error": ...} with a fixed message that never echoes the
   request, and the server keeps answering;
 - page files: only the built-in ones, every traversal spelling (plain,
@@ -144,11 +145,25 @@ def host_checks(port):
     for host in bad:
         for path in ("/", "/api/frame", "/api/pixel?x=1&y=1", "/step.js"):
             check_error("Host %r" % host, request(port, path, headers={"Host": host}), (403,))
+    # Pages of other origins (another site, another server on this
+    # machine) as browsers name them: refused; our own page and typed URLs pass.
+    ours = ["http://127.0.0.1:%d" % port, "http://localhost:%d" % port]
+    for origin in ours:
+        assert request(port, "/api/frame", headers={"Origin": origin})[0] == 200, origin
+    for site in ("same-origin", "none"):
+        assert request(port, "/api/frame", headers={"Sec-Fetch-Site": site})[0] == 200, site
+    cross = [{"Origin": o} for o in ("http://evil.example", "http://127.0.0.1:%d" % (port + 1), "null",
+                                     "https://127.0.0.1:%d" % port, "http://127.0.0.1")] + \
+            [{"Sec-Fetch-Site": s} for s in ("cross-site", "same-site")] + \
+            [{"Origin": ours[0], "Sec-Fetch-Site": "cross-site"}]
+    for hdrs in cross:
+        for path in ("/", "/api/frame", "/api/stage?name=final"):
+            check_error(hdrs, request(port, path, headers=hdrs), (403,))
     # Two Host headers, one of them ours: refused too.
     text = ("GET /api/frame HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nHost: evil.example\r\nConnection: close\r\n\r\n"
             % port).encode()
     check_error("two Hosts", exchange(port, text)[0], (403,))
-    return len(good) + 4 * len(bad) + 1
+    return len(good) + 4 * len(bad) + 4 + 3 * len(cross) + 1
 
 
 def method_checks(port):
@@ -193,6 +208,10 @@ def traversal_checks(port):
         status, headers, body = request(port, path)
         assert status == 200 and headers["content-type"] == mime and len(body) > 100, (path, status, headers)
         assert headers["x-content-type-options"] == "nosniff"
+        # Text from the model (mesh and material names) is shown as text:
+        # the page never builds HTML from strings.
+        for sink in (b"innerHTML", b"outerHTML", b"insertAdjacentHTML", b"document.write", b"eval(", b"Function("):
+            assert sink not in body, (path, sink)
         if mime.startswith("text/html"):
             csp = headers["content-security-policy"]
             assert "default-src 'self'" in csp and "frame-ancestors 'none'" in csp, csp
