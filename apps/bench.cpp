@@ -371,15 +371,17 @@ struct Result {
     std::size_t triangles = 0;
     double load_ms = 0, textures_ms = 0;
     std::size_t texture_bytes = 0;
-    Summary frame, vertex, setup_bin, raster;
-    double resolve_ms = 0, png_ms = 0;
+    int samples = 1;
+    Summary frame, vertex, setup_bin, raster;  // frame: draws and the tile-pass resolve, as render's
+    double png_ms = 0;
     std::size_t png_bytes = 0;
     double coverage = 0;  // fraction of pixels drawn
 };
 
-Result measure(const Workload& w, int threads, int tile, int repeat, int width, int height) {
+Result measure(const Workload& w, int threads, int tile, int repeat, int width, int height, int samples) {
     Result r;
     r.name = w.name;
+    r.samples = samples;
     auto t_load = Clock::now();
     DefaultScene builtin;
     Scene loaded;
@@ -424,11 +426,17 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
         fs.lights = {sun};
     }
     fs.ambient = glm::vec3(0.05f);
+    fs.samples = samples;
     Framebuffer fb(width, height);
+    // The frame writes the 8-bit image in its tile pass (tone map, sRGB), as render does.
+    std::vector<std::uint8_t> rgba8(std::size_t(width) * std::size_t(height) * 4);
+    ImageOutput out8;
+    out8.rgba8 = rgba8.data();
+    out8.tonemap = ToneMap::Aces;
     std::vector<double> frame, vertex, setup, raster;
     for (int i = 0; i <= repeat; ++i) {  // frame 0 warms up (pages in the framebuffer)
         auto t0 = Clock::now();
-        sr.render(fs, fb);
+        sr.render(fs, fb, &out8);
         const double ms = ms_since(t0);
         if (i == 0) continue;
         const FrameStats st = renderer.stats();
@@ -442,10 +450,6 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
     r.setup_bin = summarise(setup);
     r.raster = summarise(raster);
 
-    std::vector<std::uint8_t> rgba8(std::size_t(width) * std::size_t(height) * 4);
-    auto t_res = Clock::now();
-    resolve_to_srgb8(fb.color.data(), width, height, 1.0f, ToneMap::Aces, rgba8.data());
-    r.resolve_ms = ms_since(t_res);
     std::vector<std::uint8_t> rgb(std::size_t(width) * std::size_t(height) * 3);
     for (std::size_t i = 0; i < std::size_t(width) * std::size_t(height); ++i)
         for (int c = 0; c < 3; ++c) rgb[3 * i + std::size_t(c)] = rgba8[4 * i + std::size_t(c)];
@@ -459,11 +463,11 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
 }
 
 void print_result(const Result& r) {
-    std::printf("%-8s threads %d: frame_ms min=%.2f median=%.2f max=%.2f  (vertex %.2f, setup+bin %.2f, "
-                "raster+shade %.2f)  resolve %.2f  png %.1f ms %zu B | %zu tris, %.1f%% drawn, load %.1f ms, "
+    std::printf("%-8s threads %d msaa %d: frame_ms min=%.2f median=%.2f max=%.2f  (vertex %.2f, setup+bin %.2f, "
+                "raster+shade+resolve %.2f)  png %.1f ms %zu B | %zu tris, %.1f%% drawn, load %.1f ms, "
                 "textures %.1f ms %.1f MB\n",
-                r.name.c_str(), r.threads, r.frame.min, r.frame.median, r.frame.max, r.vertex.median,
-                r.setup_bin.median, r.raster.median, r.resolve_ms, r.png_ms, r.png_bytes, r.triangles,
+                r.name.c_str(), r.threads, r.samples, r.frame.min, r.frame.median, r.frame.max, r.vertex.median,
+                r.setup_bin.median, r.raster.median, r.png_ms, r.png_bytes, r.triangles,
                 100.0 * r.coverage, r.load_ms, r.textures_ms, double(r.texture_bytes) / 1e6);
     std::fflush(stdout);
 }
@@ -476,10 +480,10 @@ std::string json_result(const Result& r) {
     };
     char b[512];
     std::snprintf(b, sizeof b,
-                  "{\"workload\":\"%s\",\"threads\":%d,\"triangles\":%zu,\"coverage\":%.4f,\"load_ms\":%.3f,"
-                  "\"textures_ms\":%.3f,\"texture_bytes\":%zu,\"resolve_ms\":%.3f,\"png_ms\":%.3f,\"png_bytes\":%zu,",
-                  r.name.c_str(), r.threads, r.triangles, r.coverage, r.load_ms, r.textures_ms, r.texture_bytes,
-                  r.resolve_ms, r.png_ms, r.png_bytes);
+                  "{\"workload\":\"%s\",\"threads\":%d,\"msaa\":%d,\"triangles\":%zu,\"coverage\":%.4f,\"load_ms\":%.3f,"
+                  "\"textures_ms\":%.3f,\"texture_bytes\":%zu,\"png_ms\":%.3f,\"png_bytes\":%zu,",
+                  r.name.c_str(), r.threads, r.samples, r.triangles, r.coverage, r.load_ms, r.textures_ms,
+                  r.texture_bytes, r.png_ms, r.png_bytes);
     return std::string(b) + "\"frame_ms\":" + s(r.frame) + ",\"vertex_ms\":" + s(r.vertex) +
            ",\"setup_bin_ms\":" + s(r.setup_bin) + ",\"raster_shade_ms\":" + s(r.raster) + "}";
 }
@@ -506,17 +510,40 @@ double parse_median(const std::string& out) {
     return p == std::string::npos ? -1.0 : std::atof(out.c_str() + p + 7);
 }
 
+// The value after `key` in --stats output (render, llvmpipe-render), or -1.
+double parse_stat(const std::string& out, const std::string& key) {
+    const std::size_t p = out.find(key);
+    return p == std::string::npos ? -1.0 : std::atof(out.c_str() + p + key.size());
+}
+
+// Whether an executable takes --msaa (a build before it did not): its --help.
+bool takes_msaa(const std::string& exe) {
+    std::string out;
+    const fs::path log = fs::temp_directory_path() / ("prast_bench_help_" + std::to_string(long(getpid())));
+    const std::string cmd = shell_quote(exe) + " --help > " + shell_quote(log.string()) + " 2>&1";
+    if (std::system(cmd.c_str()) < 0) return false;
+    std::ifstream f(log);
+    out.assign(std::istreambuf_iterator<char>(f), {});
+    fs::remove(log);
+    return out.find("--msaa") != std::string::npos;
+}
+
 int side_by_side(const std::vector<std::string>& exes, const std::vector<Workload>& list, int runs, int repeat,
-                 const std::string& threads) {
+                 const std::string& threads, int samples) {
     const fs::path out_png = fs::temp_directory_path() / ("prast_bench_" + std::to_string(long(getpid())) + ".png");
-    std::printf("side by side, %d alternating runs each; A = %s, B = %s\n", runs, exes[0].c_str(), exes[1].c_str());
+    const bool msaa[2] = {takes_msaa(exes[0]), takes_msaa(exes[1])};
+    std::printf("side by side, %d alternating runs each, %s threads; A = %s (%s), B = %s (%s)\n", runs,
+                threads.c_str(), exes[0].c_str(),
+                msaa[0] ? ("--msaa " + std::to_string(samples)).c_str() : "no --msaa: 1 sample", exes[1].c_str(),
+                msaa[1] ? ("--msaa " + std::to_string(samples)).c_str() : "no --msaa: 1 sample");
     for (const Workload& w : list) {
-        std::vector<double> whole[2], frame[2];
+        std::vector<double> whole[2], frame[2], textures[2];
         for (int i = 0; i < runs; ++i)
             for (int e = 0; e < 2; ++e) {
                 std::vector<std::string> argv = {exes[std::size_t(e)]};
                 for (const std::string& a : render_args(w)) argv.push_back(a);
-                argv.insert(argv.end(), {"--threads", threads, "-o", out_png.string()});
+                if (msaa[e]) argv.insert(argv.end(), {"--msaa", std::to_string(samples)});
+                argv.insert(argv.end(), {"--threads", threads, "--stats", "-o", out_png.string()});
                 std::string out;
                 const double ms = run_process(argv, out);
                 if (ms < 0) {
@@ -524,16 +551,18 @@ int side_by_side(const std::vector<std::string>& exes, const std::vector<Workloa
                     return 1;
                 }
                 whole[e].push_back(ms);
+                textures[e].push_back(parse_stat(out, "time textures"));
                 argv.insert(argv.end(), {"--repeat", std::to_string(repeat)});
                 run_process(argv, out);
                 frame[e].push_back(parse_median(out));
             }
         const Summary wa = summarise(whole[0]), wb = summarise(whole[1]);
         const Summary fa = summarise(frame[0]), fb = summarise(frame[1]);
+        const Summary ta = summarise(textures[0]), tb = summarise(textures[1]);
         std::printf("%-8s whole process A %.1f ms B %.1f ms (A/B %.2fx) | frame median A %.2f ms B %.2f ms "
-                    "(A/B %.2fx)\n",
+                    "(A/B %.2fx) | textures A %.1f ms B %.1f ms\n",
                     w.name.c_str(), wa.median, wb.median, wa.median / wb.median, fa.median, fb.median,
-                    fa.median / fb.median);
+                    fa.median / fb.median, ta.median, tb.median);
         std::fflush(stdout);
     }
     fs::remove(out_png);
@@ -666,13 +695,15 @@ int bench_scene(const std::string& scene_path, int width, int height, const std:
 
 int usage() {
     std::fprintf(stderr,
-                 "usage: bench [--workload quad,grid,bottle,tea,bunny,builtin] [--threads 1,2] [--repeat N] [--json]\n"
+                 "usage: bench [--workload quad,grid,bottle,tea,bunny,builtin] [--threads 1,2] [--msaa 1,4] [--repeat N] [--json]\n"
                  "       bench SCENE [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME] [--flat]\n"
                  "       bench --write-workloads DIR\n"
-                 "       bench --side-by-side RENDER_A RENDER_B [--workload ...] [--runs N] [--repeat N]\n"
+                 "       bench --side-by-side RENDER_A RENDER_B [--workload ...] [--msaa 1,4] [--runs N] [--repeat N]\n"
                  "       bench --psnr A.png B.png\n"
                  "options: --workloads DIR (where the synthetic workloads live; default /tmp/prast-bench-workloads)\n"
-                 "         --assets DIR (the shared assets; default ../shared/assets)\n");
+                 "         --assets DIR (the shared assets; default ../shared/assets)\n"
+                 "         --msaa LIST (samples per pixel, default 1; side by side: given to executables whose\n"
+                 "                 --help lists --msaa, older builds draw 1 sample)\n");
     return 2;
 }
 
@@ -685,6 +716,7 @@ int main(int argc, char** argv) {
     fs::path assets = "../shared/assets";
     if (const char* env = std::getenv("PRAST_SHARED_ASSETS")) assets = env;
     int width = 1920, height = 1080, repeat = 15, runs = 5;
+    std::vector<int> msaa = {1};
     std::vector<int> threads = {2}, tiles = {kDefaultTileSize};
     std::vector<std::string> names;
     DebugView view = DebugView::None;
@@ -699,7 +731,11 @@ int main(int argc, char** argv) {
         } else if (a == "--threads") { threads = parse_list(next()); threads_given = true; }
         else if (a == "--tiles") { tiles = parse_list(next()); tiles_given = true; }
         else if (a == "--repeat") repeat = std::max(1, std::atoi(next().c_str()));
-        else if (a == "--runs") runs = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--msaa") {
+            msaa = parse_list(next());
+            for (int m : msaa)
+                if (m != 1 && m != 2 && m != 4 && m != 8) return usage();
+        } else if (a == "--runs") runs = std::max(1, std::atoi(next().c_str()));
         else if (a == "--view") { if (!parse_debug_view(next(), view)) return usage(); }
         else if (a == "--flat") flat = true;
         else if (a == "--json") json = true;
@@ -740,15 +776,20 @@ int main(int argc, char** argv) {
             }
             list.push_back(w);
         }
-        if (!exes.empty()) return side_by_side(exes, list, runs, repeat, std::to_string(threads.back()));
+        if (!exes.empty()) {
+            for (int m : msaa)
+                if (int rc = side_by_side(exes, list, runs, repeat, std::to_string(threads.back()), m)) return rc;
+            return 0;
+        }
         std::vector<std::string> out;
         for (const Workload& w : list)
-            for (int t : threads) {
-                Result r = measure(w, t, tiles.front(), repeat, width, height);
-                r.threads = t;
-                if (!json) print_result(r);
-                out.push_back(json_result(r));
-            }
+            for (int m : msaa)
+                for (int t : threads) {
+                    Result r = measure(w, t, tiles.front(), repeat, width, height, m);
+                    r.threads = t;
+                    if (!json) print_result(r);
+                    out.push_back(json_result(r));
+                }
         if (json) {
             std::printf("[");
             for (std::size_t i = 0; i < out.size(); ++i) std::printf("%s%s\n", i ? "," : "", out[i].c_str());

@@ -321,7 +321,10 @@ int main(int argc, char** argv) {
     const std::string err = parse_render_args(argc, argv, opt);
     if (!err.empty()) die(err, 2);
     if (opt.help) {
-        std::printf("llvmpipe-render: render's command line, drawn by Mesa's llvmpipe (see apps/llvmpipe_render.cpp)\n");
+        // render's usage: bench --side-by-side reads the flags it lists (--msaa).
+        std::printf("llvmpipe-render: render's command line, drawn by Mesa's llvmpipe (see apps/llvmpipe_render.cpp;\n"
+                    "llvmpipe draws 1 or 4 samples: --msaa 2 runs at 4, --msaa 8 is refused)\n%s",
+                    render_usage());
         return 0;
     }
     if (opt.hdr_output()) die("only PNG output", 2);
@@ -331,6 +334,7 @@ int main(int argc, char** argv) {
     // Scene, camera and lights exactly as render sets them up (frame 0).
     Scene scene;
     Camera camera;
+    const auto t_load = Clock::now();
     if (opt.scene.empty()) {
         DefaultScene d = make_default_scene();
         scene = std::move(d.scene);
@@ -342,6 +346,7 @@ int main(int argc, char** argv) {
             die(e.what());
         }
     }
+    const double load_ms = ms_since(t_load);
     const Bounds bounds = scene.bounds();
     const float aspect = float(opt.width) / float(opt.height);
     if (!opt.scene.empty()) camera = frame_bounds(bounds, opt.fov_deg, aspect);
@@ -367,6 +372,7 @@ int main(int argc, char** argv) {
         die("OSMesaMakeCurrent failed");
 
     // Textures: decode as render does (prast's decoders), upload, mip.
+    const auto t_tex = Clock::now();
     std::vector<GLuint> textures(scene.images.size() * 2, 0);
     auto texture = [&](const TextureRef& r, bool srgb) -> GLuint {
         if (!r.valid() || std::size_t(r.image) >= scene.images.size()) return 0;
@@ -394,6 +400,10 @@ int main(int argc, char** argv) {
         for (int i = 0; i < 7; ++i) g.maps |= g.tex[i] ? 1 << i : 0;
         materials.push_back(g);
     }
+    glFinish();  // the uploads and mip chains are done
+    const double textures_ms = ms_since(t_tex);
+    // --stats: render's two load lines (bench --side-by-side reads them).
+    if (opt.stats) std::printf("time load              %.3f ms\ntime textures          %.3f ms\n", load_ms, textures_ms);
     std::vector<GpuMesh> meshes;
     for (const Mesh& m : scene.meshes) meshes.push_back(upload(m));
 
@@ -430,6 +440,9 @@ int main(int argc, char** argv) {
         glGenRenderbuffers(2, rb);
         glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
         glRenderbufferStorageMultisample(GL_RENDERBUFFER, opt.msaa, GL_RGBA16F, opt.width, opt.height);
+        GLint granted = 0;  // the driver may round the count up
+        glGetRenderbufferParameteriv(GL_RENDERBUFFER, GL_RENDERBUFFER_SAMPLES, &granted);
+        if (opt.stats) std::printf("samples                %d (asked %d)\n", granted, opt.msaa);
         glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
         glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
         glRenderbufferStorageMultisample(GL_RENDERBUFFER, opt.msaa, GL_DEPTH_COMPONENT24, opt.width, opt.height);

@@ -65,6 +65,9 @@ struct TileView {
     int x0 = 0, y0 = 0, width = 0, height = 0;
     const float* rgba = nullptr;
     std::size_t row = 0;  // floats
+    // Every pixel holds rgba[0..3]: cleared and reached by no draw (a hook
+    // may convert one pixel and fill the tile with it).
+    bool uniform = false;
 };
 
 // A program with a fragment() is shaded; one without is a depth-only program

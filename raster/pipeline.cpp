@@ -3,6 +3,7 @@
 #include "raster/pipeline.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <numeric>
 
@@ -224,9 +225,27 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     tg.wox = r.x0;
     tg.woy = r.y0;
 
+    // A tile no draw reaches keeps its cleared colour and depth (one colour
+    // unless a fill paints a background).
+    bool reached = false;
+    for (const std::unique_ptr<detail::DrawRecord>& dp : draws_)
+        for (int j = dp->first_job; j < dp->first_job + dp->job_count && !reached; ++j) {
+            const BinJob& job = jobs_[std::size_t(j)];
+            reached = job.tile_offsets[std::size_t(tile)] != job.tile_offsets[std::size_t(tile) + 1];
+        }
+    const bool uniform = options_.clear && !options_.clear_fill && !reached;
+    // Several samples all cleared to one value resolve to exactly that value
+    // (resolve.cpp: pairwise sums of equal values, times 1/S), unless the
+    // sums overflow: such a tile is cleared in the framebuffer directly.
+    bool direct = S == 1;
+    if (uniform && S > 1) {
+        direct = true;
+        for (int k = 0; k < 4; ++k) direct &= std::fabs(options_.clear_color[k]) <= 0x1p100f;
+    }
+
     // Start: clear, or (several samples) load the target's pixels.
     if (options_.clear) {
-        if (S == 1) clear_tile(fb, r, options_.clear_color, options_.clear_depth);
+        if (direct) clear_tile(fb, r, options_.clear_color, options_.clear_depth);
         else clear_samples(tg.color, tg.depth, T, S, options_.clear_color, options_.clear_depth);
         if (options_.clear_fill && tg.color) {
             if (S == 1) {
@@ -319,7 +338,7 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     stats.tiles_touched += touched;
 
     // End: resolve the samples, then hand the tile's colour to the hook.
-    if (S > 1) resolve_samples(tg.color, tg.depth, T, S, r, fb);
+    if (!direct) resolve_samples(tg.color, tg.depth, T, S, r, fb);
     if (hook && fb.has_color()) {
         TileView v;
         v.x0 = r.x0;
@@ -328,6 +347,7 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
         v.height = r.height();
         v.rgba = &fb.color[(std::size_t(r.y0) * std::size_t(fb.width) + std::size_t(r.x0)) * 4];
         v.row = std::size_t(fb.width) * 4;
+        v.uniform = uniform;
         hook(user, v);
     }
 }

@@ -85,6 +85,15 @@ struct TriangleInTile {
     std::int64_t sample_offset[3][kMaxSamples];
 };
 
+// Eight floats with lane-wise IEEE arithmetic (the GCC/Clang vector
+// extension), for the block loops that the auto-vectoriser gets wrong: given
+// the interpolation loop, it vectorises across varyings and transposes; the
+// std::min/max clamps it leaves scalar. Only ever a local variable: as a
+// parameter or return value by value its ABI would depend on AVX (-Wpsabi).
+typedef float Lanes8 __attribute__((vector_size(32)));
+inline void load_lanes(Lanes8& v, const float* p) { std::memcpy(&v, p, sizeof v); }
+inline void store_lanes(float* p, const Lanes8& v) { std::memcpy(p, &v, sizeof v); }
+
 // A x + B y at the lanes' pixel offsets (fragment.h's lane order), by exact
 // integer sums: quad (qx, qy) adds 2 qx A + 2 qy B to quad 0.
 inline void lane_offsets(std::int64_t a, std::int64_t b, std::int64_t* out) {
@@ -281,12 +290,26 @@ inline float depth_from_barycentrics(const TriangleSetup& t, float b0, float b1,
     return std::min(std::max(z, 0.0f), 1.0f);
 }
 
+// depth_from_barycentrics for the 16 lanes, eight at a time.
+inline void block_depths(const TriangleSetup& t, const float* b0, const float* b1, const float* b2, float* z) {
+    for (int h = 0; h < kBlockLanes; h += 8) {
+        Lanes8 q0, q1, q2;
+        load_lanes(q0, b0 + h);
+        load_lanes(q1, b1 + h);
+        load_lanes(q2, b2 + h);
+        Lanes8 v = q0 * t.z[0] + q1 * t.z[1] + q2 * t.z[2];
+        v = v < 0.0f ? 0.0f : v;   // std::max(v, 0): NaN stays NaN
+        v = 1.0f < v ? 1.0f : v;   // std::min(v, 1)
+        store_lanes(z + h, v);
+    }
+}
+
 // Window depth of the 16 lanes at sample s (linear in screen space).
 inline void sample_depths(const TriangleSetup& t, const SamplePattern& sp, int s, int bx, int by, float* z) {
     alignas(64) float b0[kBlockLanes], b1[kBlockLanes], b2[kBlockLanes];
     if (sp.count == 1) block_barycentrics<false>(t, bx, by, 0.0f, 0.0f, b0, b1, b2);
     else block_barycentrics<true>(t, bx, by, sp.pixel_x(s), sp.pixel_y(s), b0, b1, b2);
-    for (int l = 0; l < kBlockLanes; ++l) z[l] = depth_from_barycentrics(t, b0[l], b1[l], b2[l]);
+    block_depths(t, b0, b1, b2, z);
 }
 
 // One block of one triangle, sample by sample: coverage, depth, depth test.
@@ -322,7 +345,7 @@ inline void test_depth(const TriangleSetup& t, const TileContext& c, int bx, int
             sample_depths(t, *c.samples, s, bx, by, bs.z[s]);
         } else {
             block_barycentrics<false>(t, bx, by, 0.0f, 0.0f, bs.b0, bs.b1, bs.b2);
-            for (int l = 0; l < kBlockLanes; ++l) bs.z[0][l] = depth_from_barycentrics(t, bs.b0[l], bs.b1[l], bs.b2[l]);
+            block_depths(t, bs.b0, bs.b1, bs.b2, bs.z[0]);
         }
         if (!bs.cover[s]) continue;
         if (depth_test) {

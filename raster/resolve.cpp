@@ -21,7 +21,10 @@ void clear_samples(float* color, float* depth, int size, int samples, const floa
     const std::size_t n = std::size_t(size) * std::size_t(size) * std::size_t(samples);
     std::fill(depth, depth + n, z);
     if (!color) return;
-    for (std::size_t i = 0; i < n; ++i) std::memcpy(color + 4 * i, rgba, 4 * sizeof(float));
+    // Eight floats (two pixels) at a time; n is even (size is a multiple of 4).
+    float pair[8];
+    for (int i = 0; i < 8; ++i) pair[i] = rgba[i & 3];
+    for (std::size_t i = 0; i < n * 4; i += 8) std::memcpy(color + i, pair, sizeof pair);
 }
 
 void load_samples(const Framebuffer& fb, const TileRect& r, float* color, float* depth, int size, int samples) {
@@ -41,22 +44,46 @@ namespace {
 
 // Pairwise sums: ((s0 + s1) + (s2 + s3)) + ... so that n equal values sum to
 // exactly n times the value (n a power of two), and their mean is the value.
+// Eight floats (two pixels' RGBA, or eight depths) at a time.
+typedef float Floats8 __attribute__((vector_size(32)));
+
 template <int S>
 inline void resolve_row(const float* color, const float* depth, std::size_t plane, int width, float* out_color,
                         float* out_depth) {
     constexpr float kInv = 1.0f / float(S);
-    for (int x = 0; x < width; ++x) {
+    int x = 0;
+    for (; x + 8 <= width; x += 8) {
+        Floats8 z;
+        std::memcpy(&z, depth + x, sizeof z);
+        for (int s = 1; s < S; ++s) {
+            Floats8 v;
+            std::memcpy(&v, depth + x + s * plane, sizeof v);
+            z = v < z ? v : z;  // std::min(z, v)
+        }
+        std::memcpy(out_depth + x, &z, sizeof z);
+    }
+    for (; x < width; ++x) {
         float z = depth[x];
         for (int s = 1; s < S; ++s) z = std::min(z, depth[x + s * plane]);
         out_depth[x] = z;
-        if (!color) continue;
-        for (int ch = 0; ch < 4; ++ch) {
-            float v[S];
-            for (int s = 0; s < S; ++s) v[s] = color[(x + s * plane) * 4 + ch];
-            for (int n = S; n > 1; n /= 2)
-                for (int i = 0; i < n / 2; ++i) v[i] = v[2 * i] + v[2 * i + 1];
-            out_color[x * 4 + ch] = v[0] * kInv;
-        }
+    }
+    if (!color) return;
+    const std::size_t n = std::size_t(width) * 4, cplane = plane * 4;
+    std::size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        Floats8 v[S];
+        for (int s = 0; s < S; ++s) std::memcpy(&v[s], color + i + s * cplane, sizeof v[s]);
+        for (int k = S; k > 1; k /= 2)
+            for (int j = 0; j < k / 2; ++j) v[j] = v[2 * j] + v[2 * j + 1];
+        v[0] = v[0] * kInv;
+        std::memcpy(out_color + i, &v[0], sizeof v[0]);
+    }
+    for (; i < n; ++i) {
+        float v[S];
+        for (int s = 0; s < S; ++s) v[s] = color[i + s * cplane];
+        for (int k = S; k > 1; k /= 2)
+            for (int j = 0; j < k / 2; ++j) v[j] = v[2 * j] + v[2 * j + 1];
+        out_color[i] = v[0] * kInv;
     }
 }
 

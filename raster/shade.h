@@ -45,15 +45,6 @@ inline void prepare_varyings(const TriangleSetup& t, const float* vertices, cons
     }
 }
 
-// Eight floats with lane-wise IEEE arithmetic (the GCC/Clang vector
-// extension), for the block loops that the auto-vectoriser gets wrong: given
-// the interpolation loop, it vectorises across varyings and transposes. Only
-// ever a local variable: as a parameter or return value by value its ABI would
-// depend on AVX (-Wpsabi).
-typedef float Lanes8 __attribute__((vector_size(32)));
-inline void load_lanes(Lanes8& v, const float* p) { std::memcpy(&v, p, sizeof v); }
-inline void store_lanes(float* p, const Lanes8& v) { std::memcpy(p, &v, sizeof v); }
-
 // One lane's varyings and depth at screen barycentrics (b0, b1, b2): the
 // float operations of the block loop below, for one lane.
 template <int NV>
@@ -83,7 +74,7 @@ void interpolate_block(const TriangleSetup& t, const TriangleVaryings<NV>& p, co
         std::memcpy(in.z, centre->z[0], sizeof in.z);
     } else {
         block_barycentrics<false>(t, bx, by, 0.0f, 0.0f, cb0, cb1, cb2);
-        for (int l = 0; l < kBlockLanes; ++l) in.z[l] = depth_from_barycentrics(t, b0[l], b1[l], b2[l]);
+        block_depths(t, cb0, cb1, cb2, in.z);
     }
 
     // Perspective-correct weights: screen barycentrics over w, renormalised;

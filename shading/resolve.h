@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "raster/frame.h"
 #include "shading/tonemap.h"
@@ -30,6 +31,16 @@ struct TileResolve {
     bool raw = false;  // data views: resolve_pixels_raw8
 
     void operator()(const TileView& v) const {
+        if (v.uniform) {  // one pixel converted, copied to the whole tile
+            std::uint8_t px[4];
+            if (raw) resolve_pixels_raw8(v.rgba, 1, px);
+            else resolve_pixels_srgb8(v.rgba, 1, exposure, tonemap, px);
+            for (int y = 0; y < v.height; ++y) {
+                std::uint8_t* out = rgba8 + (std::size_t(v.y0 + y) * std::size_t(width) + std::size_t(v.x0)) * 4;
+                for (int x = 0; x < v.width; ++x) std::memcpy(out + 4 * x, px, 4);
+            }
+            return;
+        }
         for (int y = 0; y < v.height; ++y) {
             const float* in = v.rgba + std::size_t(y) * v.row;
             std::uint8_t* out = rgba8 + (std::size_t(v.y0 + y) * std::size_t(width) + std::size_t(v.x0)) * 4;

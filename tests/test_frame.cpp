@@ -8,12 +8,15 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <mutex>
 #include <stdexcept>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "shading/resolve.h"
+#include "shading/tonemap.h"
 #include "tests/raster_test_util.h"
 
 using namespace prast;
@@ -234,6 +237,73 @@ TEST_CASE("visibility: a single opaque draw shades each covered pixel exactly on
     CHECK(r.stats().fragments_written > covered);
 }
 
+namespace {
+// Per pixel: the last triangle whose depth test passed there (from
+// fragments(), in order) and the triangle shaded there (from shaded()).
+struct WinnerObserver {
+    static constexpr bool enabled = true;
+    int W, H;
+    std::mutex m;
+    std::vector<std::int64_t> last_pass, shaded_prim;
+    std::vector<int> shaded_count;
+    bool order_broken = false;
+    std::vector<std::int64_t> last_seen;
+    WinnerObserver(int w, int h)
+        : W(w), H(h), last_pass(std::size_t(w) * h, -1), shaded_prim(std::size_t(w) * h, -1),
+          shaded_count(std::size_t(w) * h, 0), last_seen(std::size_t(w) * h, -1) {}
+    void vertex(std::uint32_t, const float*, const float*, int) {}
+    void triangle(std::uint32_t, TriangleFate, bool, const TriangleSetup*) {}
+    void binned(std::uint32_t, int) {}
+    void fragments(std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass, const float*) {
+        std::lock_guard<std::mutex> lock(m);
+        for (int l = 0; l < kBlockLanes; ++l) {
+            const std::size_t p = std::size_t(by + lane_y(l)) * std::size_t(W) + std::size_t(bx + lane_x(l));
+            if (mask & (1u << l)) {
+                order_broken |= std::int64_t(prim) < last_seen[p];
+                last_seen[p] = prim;
+            }
+            if (pass & (1u << l)) last_pass[p] = prim;
+        }
+    }
+    template <int NV>
+    void shaded(const FragmentBlock<NV>& in, const FragmentOut&, std::uint32_t live) {
+        std::lock_guard<std::mutex> lock(m);
+        for (int l = 0; l < kBlockLanes; ++l)
+            if (live & (1u << l)) {
+                const std::size_t p = std::size_t(in.y + lane_y(l)) * std::size_t(W) + std::size_t(in.x + lane_x(l));
+                shaded_prim[p] = in.prim_id;
+                ++shaded_count[p];
+            }
+    }
+};
+} // namespace
+
+TEST_CASE("observer: through the visibility pass every fragment comes in order, each winner is shaded once") {
+    const OverdrawScene sc(150, 110, 21, false);
+    const Draw& d = sc.draws[0];
+    for (int threads : {1, 3}) {
+        CAPTURE(threads);
+        Renderer r({threads, 32});
+        Framebuffer fb(sc.W, sc.H);
+        WinnerObserver obs(sc.W, sc.H);
+        PaintProgram p{sc.clip.data(), sc.var.data(), false, 1.0f};
+        r.begin_frame();
+        r.begin(fb, frame_options(FrameOptions::Visibility::Always));
+        r.submit(p, std::uint32_t(sc.clip.size()), d.idx.data(), d.idx.size(), d.state, obs);
+        r.end();
+        CHECK(!obs.order_broken);
+        int wrong = 0, shaded = 0;
+        for (std::size_t i = 0; i < obs.last_pass.size(); ++i) {
+            wrong += obs.shaded_prim[i] != obs.last_pass[i];
+            wrong += obs.shaded_count[i] > 1;
+            shaded += obs.shaded_count[i];
+        }
+        CHECK(wrong == 0);
+        CHECK(std::uint64_t(shaded) == r.stats().fragments_shaded);
+        CHECK(r.stats().fragments_written > std::uint64_t(shaded));
+    }
+}
+
 TEST_CASE("blend: alpha over a known background is src * a + dst * (1 - a), depth tested, not written") {
     const int W = 32, H = 32;
     // An opaque quad in the left half at z_ndc 0 (window depth 0.5), then a
@@ -346,6 +416,75 @@ TEST_CASE("frame: the tile hook sees every pixel once, with its final colour") {
             CHECK(seen == fb.color);
         }
     }
+}
+
+TEST_CASE("frame: tiles no draw reaches hold the resolved clear value and are handed over as uniform") {
+    // One small triangle in the top-left corner: most 16x16 tiles are never
+    // reached. Such a tile is cleared in the framebuffer directly (no samples)
+    // and converted to 8 bits from one pixel; the values must be what the
+    // sample clear and resolve give: the pairwise mean of S equal values,
+    // which is the value itself unless the sums overflow (3e38 below).
+    const int W = 150, H = 97;
+    const std::vector<glm::vec4> clip = {at(3, 2, W, H), at(30, 5, W, H), at(9, 28, W, H)};
+    const std::vector<float> var = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const std::vector<std::uint32_t> idx = {0, 1, 2};
+    const float clears[2][4] = {{0.25f, 0.5f, 0.125f, 1.0f}, {0.25f, 3e38f, -0.0f, 0.75f}};
+    for (const float* clear : clears)
+        for (int samples : {1, 2, 4, 8}) {
+            CAPTURE(samples);
+            CAPTURE(clear[1]);
+            float want[4];
+            for (int k = 0; k < 4; ++k) {
+                float v[8];
+                for (int s = 0; s < samples; ++s) v[s] = clear[k];
+                for (int n = samples; n > 1; n /= 2)
+                    for (int i = 0; i < n / 2; ++i) v[i] = v[2 * i] + v[2 * i + 1];
+                want[k] = samples == 1 ? clear[k] : v[0] * (1.0f / float(samples));
+            }
+            CHECK(std::isinf(want[1]) == (clear[1] > 1e30f && samples > 1));
+            Renderer r({3, 16});
+            Framebuffer fb(W, H);
+            FrameOptions o = frame_options(FrameOptions::Visibility::Auto, samples);
+            for (int k = 0; k < 4; ++k) o.clear_color[k] = clear[k];
+            o.clear_depth = 0.75f;
+            std::vector<std::uint8_t> tiles(std::size_t(W) * H * 4, 7), whole(tiles.size(), 9);
+            TileResolve resolve;
+            resolve.rgba8 = tiles.data();
+            resolve.width = W;
+            int uniform_tiles = 0, wrong_uniform = 0;
+            std::mutex m;
+            PaintProgram p{clip.data(), var.data(), false, 1.0f};
+            r.begin(fb, o);
+            DrawState st;
+            st.cull = CullMode::None;
+            r.submit(p, 3, idx.data(), idx.size(), st);
+            r.end([&](const TileView& v) {
+                resolve(v);
+                std::lock_guard<std::mutex> lock(m);
+                if (!v.uniform) return;
+                ++uniform_tiles;
+                for (int y = 0; y < v.height; ++y)
+                    for (int x = 0; x < v.width; ++x)
+                        for (int c = 0; c < 4; ++c)
+                            wrong_uniform += std::memcmp(&v.rgba[std::size_t(y) * v.row + 4 * std::size_t(x) + std::size_t(c)], &v.rgba[c], sizeof(float)) != 0;
+            });
+            CHECK(uniform_tiles > 40);
+            CHECK(wrong_uniform == 0);
+            int drawn = 0, wrong = 0;
+            for (int y = 0; y < H; ++y)
+                for (int x = 0; x < W; ++x) {
+                    const float* px = fb.pixel(x, y);
+                    if (fb.depth[std::size_t(y) * W + std::size_t(x)] != 0.75f) {
+                        ++drawn;
+                        continue;
+                    }
+                    for (int c = 0; c < 4; ++c) wrong += std::memcmp(&px[c], &want[c], sizeof(float)) != 0;
+                }
+            CHECK(drawn > 200);
+            CHECK(wrong == 0);
+            resolve_to_srgb8(fb.color.data(), W, H, 1.0f, ToneMap::Aces, whole.data());
+            CHECK(tiles == whole);
+        }
 }
 
 TEST_CASE("frame: misuse is refused") {

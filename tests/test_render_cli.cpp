@@ -309,6 +309,32 @@ TEST_CASE("the same frame is byte-identical for any --threads and --tile") {
     }
 }
 
+TEST_CASE("--msaa: the default is 4 samples; every count is byte-identical for any --threads and --tile") {
+    RenderOptions o;
+    REQUIRE(parse("", o) == "");
+    CHECK(o.msaa == 4);
+    for (const char* bad : {"--msaa 3", "--msaa 16", "--msaa 0", "--msaa x"}) {
+        CAPTURE(bad);
+        const std::string err = parse(bad);
+        CHECK(err.find("must be 1, 2, 4 or 8") != std::string::npos);
+    }
+    CliSandbox box;
+    REQUIRE(render(box, with(kSmall, {"-o", "default.png"})).code == 0);
+    std::vector<std::uint8_t> previous;
+    for (const char* n : {"1", "2", "4", "8"}) {
+        CAPTURE(n);
+        const std::string a = std::string("a") + n + ".png", b = std::string("b") + n + ".png";
+        REQUIRE(render(box, with(kSmall, {"--msaa", n, "--threads", "1", "-o", a})).code == 0);
+        REQUIRE(render(box, with(kSmall, {"--msaa", n, "--threads", "3", "--tile", "16", "-o", b})).code == 0);
+        const std::vector<std::uint8_t> bytes = read_bytes(box.path(a));
+        REQUIRE(!bytes.empty());
+        CHECK(read_bytes(box.path(b)) == bytes);
+        if (std::string(n) == "4") CHECK(read_bytes(box.path("default.png")) == bytes);
+        CHECK(bytes != previous);  // the edges change with the sample count
+        previous = bytes;
+    }
+}
+
 TEST_CASE("a turntable split in two --frame-range runs equals a single run") {
     CliSandbox box;
     fs::create_directories(box.work() / "one");
