@@ -41,8 +41,10 @@ const char* step_usage() {
 "  scene, camera, light and view flags as render's (render --help):\n"
 "  --size WxH --eye X,Y,Z --target X,Y,Z --up X,Y,Z --fov DEG --near N --far F\n"
 "  --sun X,Y,Z:R,G,B --point X,Y,Z:R,G,B --ambient R,G,B --no-default-lights\n"
-"  --brdf default|gltf --exposure E --tonemap none|aces|neutral --msaa N\n"
-"  --threads N --tile N --shadows on|off --shadow-size N\n"
+"  --env FILE.hdr --env-intensity E --env-rotate DEG --ibl split-sum\n"
+"  --background env|blur|black|R,G,B --brdf default|gltf --energy off|conserve\n"
+"  --exposure E --tonemap none|aces|neutral --msaa N --threads N --tile N\n"
+"  --shadows on|off --shadow-size N\n"
 "  --help, --version    exit codes: 0 ok, 1 bad file or a failed command, 2 bad usage\n";
 }
 

@@ -587,21 +587,84 @@ TEST_CASE("rendering with an environment is byte-identical for any thread count 
         scene.materials.push_back(m);
         scene.meshes.push_back(make_uv_sphere(glm::vec3(float(i) - 1.0f, 0.0f, 0.0f), 0.45f, 32, 16, i));
     }
-    auto frame = [&](int threads, int tile, bool energy) {
+    auto frame = [&](int threads, int tile, bool energy, int samples) {
         Renderer r({threads, tile});
         SceneRenderer sr(scene, r);
         FrameSettings fs;
         fs.camera.eye = {0.3f, 0.5f, 4.0f};
         fs.energy = energy;
+        fs.samples = samples;
         Framebuffer fb(101, 67);
         sr.render(fs, fb);
         return hash_bytes(fb.color.data(), fb.color.size() * sizeof(float));
     };
-    for (bool energy : {false, true}) {
-        const std::uint64_t ref = frame(1, 64, energy);
-        CHECK(frame(2, 64, energy) == ref);
-        CHECK(frame(3, 16, energy) == ref);
-        CHECK(frame(2, 256, energy) == ref);
+    for (int samples : {1, 4}) {
+        for (bool energy : {false, true}) {
+            CAPTURE(samples); CAPTURE(energy);
+            const std::uint64_t ref = frame(1, 64, energy, samples);
+            CHECK(frame(2, 64, energy, samples) == ref);
+            CHECK(frame(3, 16, energy, samples) == ref);
+            CHECK(frame(2, 256, energy, samples) == ref);
+        }
+    }
+}
+
+TEST_CASE("with several samples per pixel, the samples no triangle covers resolve to the background") {
+    // The frame clears every sample to its pixel's background, so a pixel is
+    // (covered samples' colours + uncovered ones x background) / S: the same
+    // frame over the sky and over black differs by k / S times the pixel's
+    // background, k the uncovered samples. Uncovered pixels equal the
+    // background exactly.
+    Scene scene;
+    scene.environment = std::make_shared<const Image>(procedural_env(128));
+    Material m;
+    m.metallic_factor = 1.0f;
+    m.roughness_factor = 0.2f;
+    scene.materials.push_back(m);
+    scene.meshes.push_back(make_uv_sphere(glm::vec3(0.0f), 0.6f, 32, 16, 0));
+    Renderer r({2, 32});
+    SceneRenderer sr(scene, r);
+    for (Background mode : {Background::Env, Background::Blur}) {
+        for (int samples : {1, 2, 4, 8}) {
+            CAPTURE(int(mode)); CAPTURE(samples);
+            FrameSettings fs;
+            fs.camera.eye = {0.2f, 0.4f, 3.0f};
+            fs.samples = samples;
+            fs.background = mode;
+            Framebuffer sky(96, 64), black(96, 64);
+            sr.render(fs, sky);
+            fs.background = Background::Black;
+            sr.render(fs, black);
+            fs.background = mode;
+            const BackgroundFill bg = frame_background(fs, sr.environment(fs), 96, 64);
+            int empty = 0, edge = 0, inside = 0;
+            double worst = 0.0;
+            for (int y = 0; y < 64; ++y)
+                for (int x = 0; x < 96; ++x) {
+                    const float* a = sky.pixel(x, y);
+                    const float* b = black.pixel(x, y);
+                    const glm::vec3 c = bg.at(x, y);
+                    // k / S from the brightest channel, then every channel checked.
+                    const int ch = c.b >= c.r && c.b >= c.g ? 2 : c.g >= c.r ? 1 : 0;
+                    const int k = int(std::lround(double(a[ch] - b[ch]) / double(c[ch]) * samples));
+                    REQUIRE(k >= 0);
+                    REQUIRE(k <= samples);
+                    if (k == samples) {
+                        ++empty;
+                        CHECK(b[0] == 0.0f);
+                        for (int i = 0; i < 3; ++i) CHECK(a[i] == c[i]);  // the background itself, bit for bit
+                    } else {
+                        ++(k == 0 ? inside : edge);
+                        for (int i = 0; i < 3; ++i)
+                            worst = std::max(worst, std::fabs(double(a[i] - b[i]) - double(c[i]) * k / samples));
+                    }
+                }
+            CHECK(empty > 2000);
+            CHECK(inside > 500);
+            if (samples > 1) CHECK(edge > 40);  // the silhouette, partly covered
+            else CHECK(edge == 0);
+            CHECK(worst < 1e-6);
+        }
     }
 }
 

@@ -11,6 +11,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -375,6 +376,39 @@ TEST_CASE("sessions: bad commands get one line each and the session goes on") {
     CHECK(errors == 18);
     CHECK(r.out.find("srgb8 ") != std::string::npos);  // the last command still ran
     CHECK(r.err.empty());
+}
+
+TEST_CASE("flags: step takes every flag of render's --help, or refuses it") {
+    // A render flag step neither lists nor refuses would be parsed and then
+    // ignored, and step would explain a frame render does not draw: a new
+    // flag must reach FrameRequest (stepper/scene_setup.h) and step's --help,
+    // or join kNotForStep in apps/step.cpp.
+    auto flags = [](const std::string& help) {
+        std::vector<std::string> out;
+        for (std::size_t i = help.find("--"); i != std::string::npos; i = help.find("--", i + 2)) {
+            std::size_t e = i + 2;
+            while (e < help.size() && (std::isalnum(static_cast<unsigned char>(help[e])) || help[e] == '-')) ++e;
+            if (e > i + 2) out.push_back(help.substr(i, e - i));
+        }
+        return out;
+    };
+    CliSandbox box;
+    const CliRun render_help = box.run_exe(kRender, {"--help"}), step_help = box.run_exe(kStep, {"--help"});
+    REQUIRE(render_help.code == 0);
+    REQUIRE(step_help.code == 0);
+    const std::vector<std::string> listed = flags(step_help.out);
+    // render-only: one frame has no turntable, output file, repeat, stats or
+    // debug view; --samples belongs to --ibl reference, which step refuses.
+    const std::vector<std::string> refused = {"--output", "--frames", "--orbit", "--frame-range", "--repeat",
+                                              "--view", "--stats"};
+    for (const std::string& f : flags(render_help.out)) {
+        INFO("render flag " << f);
+        if (std::find(listed.begin(), listed.end(), f) != listed.end() || f == "--samples") continue;
+        REQUIRE(std::find(refused.begin(), refused.end(), f) != refused.end());
+        const CliRun r = box.run_exe(kStep, {f, "1"});
+        CHECK(r.code == 2);
+        CHECK(r.err.find("not a step option") != std::string::npos);
+    }
 }
 
 TEST_CASE("flags: render's flags that make no sense for one frame, and bad files") {

@@ -354,9 +354,11 @@ def slow_client_checks(port):
         assert data == b"" or parse_answers(data)[0][0] == 400, data[:100]
         c.close()
     # Trickling clients (a header byte every 0.3 s, below the read timeout)
-    # hold a worker each; with fewer of them than workers, others are served.
+    # hold a worker each; with fewer of them than workers, others are served
+    # while all of them are still connected and trickling.
     stop = threading.Event()
-    trickled = []
+    lock = threading.Lock()
+    trickling, cut_early = [0], []
 
     def trickle():
         with socket.create_connection(("127.0.0.1", port), timeout=60) as c:
@@ -366,21 +368,27 @@ def slow_client_checks(port):
                 try:
                     c.sendall(b"z")
                 except (BrokenPipeError, ConnectionResetError):
-                    break
+                    cut_early.append(sent)
+                    return
                 sent += 1
+                if sent == 3:
+                    with lock:
+                        trickling[0] += 1
                 time.sleep(0.3)
-            trickled.append(sent)
 
     threads = [threading.Thread(target=trickle) for _ in range(8)]
     for t in threads:
         t.start()
-    time.sleep(1)
+    deadline = time.monotonic() + 60  # a bound, not a measurement: connecting under load may take seconds
+    while trickling[0] < 8 and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert trickling[0] == 8, trickling
     for _ in range(10):
         check_good(port)
     stop.set()
     for t in threads:
         t.join(60)
-    assert len(trickled) == 8 and min(trickled) >= 3, trickled
+    assert not cut_early, ("trickling clients were cut off while sending often enough", cut_early)
     # A client slower than the read timeout (a byte every 3 s) is cut off.
     with socket.create_connection(("127.0.0.1", port), timeout=60) as c:
         c.sendall(b"GET /api/frame HTTP/1.1\r\n")
