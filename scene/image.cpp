@@ -13,6 +13,11 @@
 #include <string>
 
 #include <stb_image.h>
+#include <unistd.h>
+
+#include "scene/file_access.h"
+#include "scene/hdr_guard.h"
+#include "scene/messages.h"
 
 namespace prast {
 
@@ -51,30 +56,6 @@ const char* sniff_format(const unsigned char* p, std::size_t n) {
     return nullptr;
 }
 
-// Reads a whole file; stb_image's memory API then decodes it. Reading it
-// ourselves lets us tell a directory, an empty file and an unreadable one apart.
-std::vector<unsigned char> read_file(const std::string& path, const std::string& name) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-        throw LoadError(name + ": is a directory, not an image file");
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw LoadError(name + ": cannot open: " + std::strerror(errno));
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> closer(f, std::fclose);
-    std::vector<unsigned char> bytes;
-    unsigned char chunk[1 << 16];
-    for (;;) {
-        const std::size_t n = std::fread(chunk, 1, sizeof chunk, f);
-        bytes.insert(bytes.end(), chunk, chunk + n);
-        // stb_image's memory API takes an int length.
-        if (bytes.size() > std::size_t(INT_MAX))
-            throw LoadError(name + ": file too large (over 2 GiB)");
-        if (n < sizeof chunk) break;
-    }
-    if (std::ferror(f)) throw LoadError(name + ": read error: " + std::strerror(errno));
-    if (bytes.empty()) throw LoadError(name + ": empty file");
-    return bytes;
-}
-
 // Expands `comp` channels per texel to RGBA, decoding colour channels with
 // `colour` and alpha with `alpha`.
 template <class T, class ColourFn, class AlphaFn>
@@ -97,20 +78,28 @@ void expand_to_rgba(const T* src, int comp, std::size_t count, float* dst, Colou
 } // namespace
 
 Image decode_image(const ImageSource& src, bool srgb) {
-    const std::string name = !src.name.empty()   ? src.name
-                             : !src.path.empty() ? src.path
-                                                 : std::string("<embedded image>");
+    const std::string name = printable(!src.name.empty()   ? src.name
+                                       : !src.path.empty() ? src.path
+                                                           : std::string("<embedded image>"));
     // Get the encoded bytes: embedded ones win over the path.
     std::vector<unsigned char> file_bytes;
     const std::vector<unsigned char>* bytes = &src.bytes;
     if (src.bytes.empty()) {
         if (src.path.empty()) throw LoadError(name + ": no image data (no path, no bytes)");
-        file_bytes = read_file(src.path, name);
+        // Only a regular file, never past what stb_image's int length takes.
+        file_bytes = read_regular_file(src.path, std::uint64_t(INT_MAX), name);
         bytes = &file_bytes;
     }
     if (bytes->size() > std::size_t(INT_MAX)) throw LoadError(name + ": image data too large");
     const stbi_uc* data = bytes->data();
     const int len = int(bytes->size());
+
+    // Radiance data goes through the guard first: stb_image 2.27 can hang on it.
+    if (looks_like_hdr(data, bytes->size())) {
+        int hw = 0, hh = 0;
+        const std::string bad = check_hdr_data(data, bytes->size(), hw, hh);
+        if (!bad.empty()) throw LoadError(name + ": cannot decode HDR image: " + bad);
+    }
 
     // Check the header before decoding anything: refuse absurd sizes up front.
     int w = 0, h = 0, comp = 0;
@@ -169,6 +158,47 @@ Image decode_image(const ImageSource& src, bool srgb) {
         else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
     }
     return img;
+}
+
+namespace {
+
+// stb_image's callbacks over a file descriptor, for reading headers only.
+int fd_read(void* user, char* data, int size) {
+    for (;;) {
+        const ssize_t n = ::read(*static_cast<int*>(user), data, std::size_t(size));
+        if (n < 0 && errno == EINTR) continue;
+        return n < 0 ? 0 : int(n);
+    }
+}
+void fd_skip(void* user, int n) { ::lseek(*static_cast<int*>(user), n, SEEK_CUR); }
+int fd_eof(void* user) {
+    const int fd = *static_cast<int*>(user);
+    const off_t here = ::lseek(fd, 0, SEEK_CUR), end = ::lseek(fd, 0, SEEK_END);
+    ::lseek(fd, here, SEEK_SET);
+    return here >= end;
+}
+
+} // namespace
+
+bool image_dimensions(const ImageSource& src, int& width, int& height) {
+    int comp = 0;
+    width = height = 0;
+    if (!src.bytes.empty()) {
+        if (src.bytes.size() > std::size_t(INT_MAX)) return false;
+        return stbi_info_from_memory(src.bytes.data(), int(src.bytes.size()), &width, &height, &comp) != 0;
+    }
+    if (src.path.empty()) return false;
+    std::uint64_t size = 0;
+    int fd = -1;
+    try {
+        fd = open_regular_file(src.path, src.name, size);
+    } catch (const LoadError&) {
+        return false;
+    }
+    const stbi_io_callbacks io{fd_read, fd_skip, fd_eof};
+    const int ok = stbi_info_from_callbacks(&io, &fd, &width, &height, &comp);
+    ::close(fd);
+    return ok != 0;
 }
 
 } // namespace prast

@@ -43,4 +43,9 @@ constexpr std::int64_t kMaxImageTexels = std::int64_t(1) << 28;
 // path) for a missing, unreadable, empty, corrupt, zero-sized or oversized image.
 Image decode_image(const ImageSource& src, bool srgb);
 
+// The width and height in an image's header, read without decoding (a file
+// only as far as its header, through scene/file_access.h); false when the
+// header cannot be read. For planning memory before decoding.
+bool image_dimensions(const ImageSource& src, int& width, int& height);
+
 } // namespace prast

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <new>
 
 namespace prast {
 
@@ -70,6 +71,8 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
             const TextureRef* user = first_user();
             Wrap ws = user ? user->wrap_s : Wrap::Repeat, wt = user ? user->wrap_t : Wrap::Repeat;
             textures_[slot] = std::make_unique<Texture>(Texture::from_image(std::move(img), ws, wt));
+        } catch (const std::bad_alloc&) {
+            errors[slot] = (src.name.empty() ? src.path : src.name) + ": out of memory while decoding";
         } catch (const std::exception& e) {
             errors[slot] = e.what();
         }
