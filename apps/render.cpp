@@ -243,8 +243,9 @@ std::string check_camera(const Camera& cam, const RenderOptions& opt, const Boun
 
 // Bytes a render holds at its peak, estimated before the textures are decoded
 // or a frame drawn: the scene as loaded, the decoded textures with their mip
-// chains (float RGBA, 4/3 for the chain), the pipeline's per-vertex and
-// per-triangle work for the largest mesh, the framebuffer and 8-bit image.
+// chains (the file's bytes per texel, 16 for float RGBA; 4/3 for the chain),
+// the pipeline's per-vertex and per-triangle work for the largest mesh, the
+// framebuffer and 8-bit image.
 struct MemoryPlan {
     std::uint64_t scene = 0, textures = 0, pipeline = 0, image = 0;
     std::uint64_t texels = 0;
@@ -252,7 +253,6 @@ struct MemoryPlan {
     std::uint64_t total() const { return scene + textures + pipeline + image; }
 };
 
-constexpr std::uint64_t kTextureBytesPerTexel = 16 * 4 / 3 + 1;  // shading/texture.h: glm::vec4 per texel
 constexpr std::uint64_t kPipelineBytesPerVertex = 96;             // clip position and varyings
 constexpr std::uint64_t kPipelineBytesPerTriangle = 96;           // set-up edges and bin entries
 
@@ -279,18 +279,20 @@ MemoryPlan plan_memory(const Scene& scene, const RenderOptions& opt) {
         if (u.first >= 0 && std::size_t(u.first) < scene.images.size()) ++per_image[std::size_t(u.first)];
     for (std::size_t i = 0; i < scene.images.size(); ++i) {
         if (per_image[i] == 0) continue;
-        int w = 0, h = 0;
+        int w = 0, h = 0, texel_bytes = 16;
         const ImageSource& src = scene.images[i];
         if (src.decoded) {
             w = src.decoded->width;
             h = src.decoded->height;
-        } else if (!image_dimensions(src, w, h)) {
+            texel_bytes = src.decoded->is_8bit() ? src.decoded->channels : 16;
+        } else if (!image_dimensions(src, w, h, &texel_bytes)) {
             continue;  // decoding will fail and say why
         }
-        plan.texels += std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(per_image[i]);
+        const std::uint64_t texels = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(per_image[i]);
+        plan.texels += texels;
+        plan.textures += texels * std::uint64_t(texel_bytes) * 4 / 3;
         ++plan.images;
     }
-    plan.textures = plan.texels * kTextureBytesPerTexel;
     plan.image = std::uint64_t(opt.width) * std::uint64_t(opt.height) * kBytesPerPixel;
     return plan;
 }

@@ -1,5 +1,7 @@
-// Image decoding: stb_image (PNG, JPEG, HDR, ...) to linear float RGBA, with
-// sRGB colour channels decoded first; see image.h.
+// Image decoding: 8-bit PNG through libpng and zlib (linked statically: their
+// inflate and row filters are several times faster than stb_image's), every
+// other format (JPEG, HDR, 16-bit PNG, ...) through stb_image. 8-bit files
+// keep their bytes, 16-bit and HDR files become linear float RGBA; see image.h.
 #include "scene/image.h"
 
 #include <array>
@@ -12,11 +14,21 @@
 #include <memory>
 #include <string>
 
+#include <algorithm>
+#include <csetjmp>
+#include <cstdlib>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#include <png.h>
+#include <zlib.h>
 #include <stb_image.h>
 #include <unistd.h>
 
 #include "scene/file_access.h"
 #include "scene/hdr_guard.h"
+#include "scene/jpeg_guard.h"
 #include "scene/messages.h"
 
 namespace prast {
@@ -28,17 +40,10 @@ float srgb_to_linear(float c) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
-const std::array<float, 256>& srgb_table() {
-    static const std::array<float, 256> table = [] {
-        std::array<float, 256> t{};
-        for (int i = 0; i < 256; ++i) t[i] = srgb_to_linear(float(i) / 255.0f);
-        return t;
-    }();
-    return table;
-}
 
 std::string stbi_reason() {
     const char* r = stbi_failure_reason();
+    if (r && std::string(r) == "outofmem") return "out of memory";
     return r ? r : "unknown error";
 }
 
@@ -75,6 +80,323 @@ void expand_to_rgba(const T* src, int comp, std::size_t count, float* dst, Colou
     }
 }
 
+// ---- The common PNGs (8-bit grey, grey+alpha, RGB, RGBA, not interlaced, no
+// tRNS) decoded here: chunks walked with their lengths and CRCs checked, the
+// IDAT data inflated by zlib one row at a time, and the rows unfiltered with
+// SSE2 for the Paeth filter (3 or 4 bytes a pixel), which libpng as Debian
+// builds it does a byte at a time. Everything else goes to libpng below.
+
+std::uint32_t be32(const unsigned char* p) {
+    return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 | std::uint32_t(p[3]);
+}
+
+enum class FastPng { Done, NotMine, Failed };
+
+// Paeth predictor (ISO 15948 9.4) of one byte.
+inline int paeth_predict(int a, int b, int c) {
+    const int pa = std::abs(b - c), pb = std::abs(a - c), pc = std::abs(a + b - 2 * c);
+    return pa <= pb && pa <= pc ? a : (pb <= pc ? b : c);
+}
+
+#if defined(__SSE2__)
+// Paeth reconstruction of a row of BPP-byte pixels (3 or 4), one pixel per
+// step in 16-bit lanes: a (left), b (above), c (upper left).
+template <int BPP>
+void paeth_sse2(const unsigned char* raw, const unsigned char* above, unsigned char* out, std::size_t n) {
+    const __m128i zero = _mm_setzero_si128();
+    __m128i a = zero, c = zero;
+    std::int32_t word;
+    for (std::size_t i = 0; i < n; i += BPP) {
+        std::memcpy(&word, above + i, 4);
+        const __m128i b = _mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero);
+        std::memcpy(&word, raw + i, 4);
+        const __m128i x = _mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero);
+        // pa = |b - c|, pb = |a - c|, pc = |a + b - 2c| (p = a + b - c).
+        const __m128i bc = _mm_sub_epi16(b, c), ac = _mm_sub_epi16(a, c);
+        const __m128i abc = _mm_add_epi16(bc, ac);
+        const __m128i pa = _mm_max_epi16(bc, _mm_sub_epi16(zero, bc));
+        const __m128i pb = _mm_max_epi16(ac, _mm_sub_epi16(zero, ac));
+        const __m128i pc = _mm_max_epi16(abc, _mm_sub_epi16(zero, abc));
+        // a if pa is the smallest, else b if pb is, else c (ties in that order).
+        const __m128i smallest = _mm_min_epi16(pc, _mm_min_epi16(pa, pb));
+        const __m128i use_a = _mm_cmpeq_epi16(pa, smallest);
+        const __m128i use_b = _mm_andnot_si128(use_a, _mm_cmpeq_epi16(pb, smallest));
+        const __m128i use_c = _mm_andnot_si128(_mm_or_si128(use_a, use_b), _mm_set1_epi16(-1));
+        const __m128i pred = _mm_or_si128(_mm_or_si128(_mm_and_si128(use_a, a), _mm_and_si128(use_b, b)),
+                                          _mm_and_si128(use_c, c));
+        const __m128i value = _mm_and_si128(_mm_add_epi16(x, pred), _mm_set1_epi16(0xFF));
+        word = _mm_cvtsi128_si32(_mm_packus_epi16(value, zero));
+        std::memcpy(out + i, &word, BPP);
+        a = value;
+        c = b;
+    }
+}
+#endif
+
+// Reconstructs one row (filter byte already read) from the filtered bytes
+// `raw` (4 readable bytes past the row) and the row above (null for row 0,
+// else 4 readable bytes past it: the row below follows it in memory).
+bool unfilter_row(int filter, const unsigned char* raw, const unsigned char* above, unsigned char* out,
+                  std::size_t n, int bpp) {
+    const std::size_t b = std::size_t(bpp);
+    switch (filter) {
+    case 0: std::memcpy(out, raw, n); return true;
+    case 1:
+        for (std::size_t i = 0; i < n; ++i) out[i] = (unsigned char)(raw[i] + (i >= b ? out[i - b] : 0));
+        return true;
+    case 2:
+        if (!above) std::memcpy(out, raw, n);
+        else for (std::size_t i = 0; i < n; ++i) out[i] = (unsigned char)(raw[i] + above[i]);
+        return true;
+    case 3:
+        for (std::size_t i = 0; i < n; ++i)
+            out[i] = (unsigned char)(raw[i] + (((i >= b ? out[i - b] : 0) + (above ? above[i] : 0)) >> 1));
+        return true;
+    case 4:
+        if (!above) {  // Paeth with no row above is Sub
+            for (std::size_t i = 0; i < n; ++i) out[i] = (unsigned char)(raw[i] + (i >= b ? out[i - b] : 0));
+            return true;
+        }
+#if defined(__SSE2__)
+        if (bpp == 3) return paeth_sse2<3>(raw, above, out, n), true;
+        if (bpp == 4) return paeth_sse2<4>(raw, above, out, n), true;
+#endif
+        for (std::size_t i = 0; i < n; ++i) {
+            const int left = i >= b ? out[i - b] : 0, up_left = i >= b ? above[i - b] : 0;
+            out[i] = (unsigned char)(raw[i] + paeth_predict(left, above[i], up_left));
+        }
+        return true;
+    default: return false;
+    }
+}
+
+FastPng decode_png_fast(const unsigned char* data, std::size_t size, int w, int h, Image& img, std::string& error) {
+    // Walk the chunk headers first: is this a PNG of the common kind?
+    if (size < 8 + 25) return FastPng::NotMine;
+    std::size_t pos = 8;
+    int channels = 0;
+    bool seen_idat = false;
+    while (pos + 12 <= size) {
+        const std::uint32_t len = be32(data + pos);
+        if (len > size - pos - 12) return FastPng::NotMine;  // libpng names the problem
+        const unsigned char* type = data + pos + 4;
+        if (pos == 8) {
+            if (std::memcmp(type, "IHDR", 4) != 0 || len != 13) return FastPng::NotMine;
+            const unsigned char* d = data + pos + 8;
+            if (int(be32(d)) != w || int(be32(d + 4)) != h || d[8] != 8 || d[10] != 0 || d[11] != 0 || d[12] != 0)
+                return FastPng::NotMine;
+            static const int kChannels[7] = {1, 0, 3, 0, 2, 0, 4};
+            if (d[9] > 6 || !kChannels[d[9]]) return FastPng::NotMine;
+            channels = kChannels[d[9]];
+        }
+        if (std::memcmp(type, "tRNS", 4) == 0) return FastPng::NotMine;
+        if (std::memcmp(type, "IDAT", 4) == 0) seen_idat = true;
+        if (std::memcmp(type, "IEND", 4) == 0) break;
+        pos += 12 + std::size_t(len);
+    }
+    if (!channels || !seen_idat) return FastPng::NotMine;
+
+    // Inflate the IDAT chunks into `raw`, many rows at a time (zlib copies
+    // what each call writes into its 32 KiB window: calls of a few hundred KiB
+    // keep that copy small), and unfilter them. The zlib header is read here
+    // and the data inflated raw: the chunk CRCs already guard the bytes, so
+    // the Adler-32 of the pixels (7% of the decode) is not computed.
+    const std::size_t stride = std::size_t(w) * std::size_t(channels);
+    const std::size_t rows_per_call = std::max<std::size_t>(1, (std::size_t(256) << 10) / (stride + 1));
+    img.pixels.resize(stride * std::size_t(h) + 4);  // 4 spare bytes for the 4-byte reads
+    std::vector<unsigned char> raw((stride + 1) * std::min<std::size_t>(rows_per_call, std::size_t(h)) + 4, 0);
+    z_stream z{};
+    if (inflateInit2(&z, -15) != Z_OK) {
+        error = "zlib: cannot start";
+        return FastPng::Failed;
+    }
+    struct EndInflate {
+        z_stream* z;
+        ~EndInflate() { inflateEnd(z); }
+    } end_inflate{&z};
+    pos = 8;
+    std::size_t idat_left = 0;
+    const unsigned char* idat = nullptr;
+    auto next_idat = [&]() -> bool {  // the next IDAT chunk's data, CRC checked
+        while (pos + 12 <= size) {
+            const std::uint32_t len = be32(data + pos);
+            if (len > size - pos - 12) return false;
+            const unsigned char* type = data + pos + 4;
+            if (std::uint32_t(crc32(0L, type, uInt(len + 4))) != be32(data + pos + 8 + len)) {
+                error = std::string("CRC error in the ") + std::string(reinterpret_cast<const char*>(type), 4) +
+                        " chunk";
+                return false;
+            }
+            const std::size_t at = pos;
+            pos += 12 + std::size_t(len);
+            if (std::memcmp(type, "IDAT", 4) == 0) {
+                idat = data + at + 8;
+                idat_left = len;
+                return true;
+            }
+            if (std::memcmp(type, "IEND", 4) == 0) return false;
+        }
+        return false;
+    };
+    // The zlib header (RFC 1950): deflate, window <= 32 KiB, no preset dictionary.
+    unsigned char header[2];
+    for (int i = 0; i < 2; ++i) {
+        while (idat_left == 0)
+            if (!next_idat()) {
+                if (error.empty()) error = "truncated image data";
+                return FastPng::Failed;
+            }
+        header[i] = *idat++;
+        --idat_left;
+    }
+    if ((header[0] & 0x0F) != 8 || (header[0] >> 4) > 7 || (header[1] & 0x20) ||
+        (unsigned(header[0]) * 256u + header[1]) % 31u != 0) {
+        error = "corrupt image data (bad zlib header)";
+        return FastPng::Failed;
+    }
+    for (int y0 = 0; y0 < h; y0 += int(rows_per_call)) {
+        const int y1 = std::min(h, y0 + int(rows_per_call));
+        z.next_out = raw.data();
+        z.avail_out = uInt((stride + 1) * std::size_t(y1 - y0));
+        while (z.avail_out > 0) {
+            if (z.avail_in == 0) {
+                if (idat_left == 0 && !next_idat()) {
+                    if (error.empty()) error = "truncated image data";
+                    return FastPng::Failed;
+                }
+                const std::size_t take = std::min<std::size_t>(idat_left, 1u << 30);
+                z.next_in = const_cast<unsigned char*>(idat);
+                z.avail_in = uInt(take);
+                idat += take;
+                idat_left -= take;
+            }
+            const int rc = inflate(&z, Z_NO_FLUSH);
+            if (rc == Z_STREAM_END && z.avail_out > 0) {
+                error = "not enough image data";
+                return FastPng::Failed;
+            }
+            if (rc != Z_OK && rc != Z_STREAM_END && !(rc == Z_BUF_ERROR && z.avail_in == 0)) {
+                error = std::string("corrupt image data (zlib: ") + (z.msg ? z.msg : "error") + ")";
+                return FastPng::Failed;
+            }
+        }
+        for (int y = y0; y < y1; ++y) {
+            const unsigned char* r = raw.data() + std::size_t(y - y0) * (stride + 1);
+            unsigned char* row = img.pixels.data() + std::size_t(y) * stride;
+            if (!unfilter_row(r[0], r + 1, y > 0 ? row - stride : nullptr, row, stride, channels)) {
+                error = "bad row filter type " + std::to_string(int(r[0]));
+                return FastPng::Failed;
+            }
+        }
+    }
+    // Later chunks (after the pixels) are not needed; stb_image and libpng
+    // read no further either.
+    img.pixels.resize(stride * std::size_t(h));
+    img.width = w;
+    img.height = h;
+    img.channels = channels;
+    return FastPng::Done;
+}
+
+// ---- 8-bit PNG through libpng. libpng reports errors by longjmp: no object
+// with a destructor is created between the setjmp and the end of the decode
+// (the output vector belongs to the caller).
+
+struct PngSource {
+    const unsigned char* data;
+    std::size_t size, pos;
+    char error[160];
+};
+
+void png_read_memory(png_structp png, png_bytep out, png_size_t n) {
+    PngSource* s = static_cast<PngSource*>(png_get_io_ptr(png));
+    if (n > s->size - s->pos) png_error(png, "truncated file");
+    std::memcpy(out, s->data + s->pos, n);
+    s->pos += n;
+}
+
+[[noreturn]] void png_on_error(png_structp png, png_const_charp message) {
+    PngSource* s = static_cast<PngSource*>(png_get_error_ptr(png));
+    std::snprintf(s->error, sizeof s->error, "%s", message ? message : "unknown error");
+    png_longjmp(png, 1);
+}
+
+void png_on_warning(png_structp, png_const_charp) {}
+
+// Decodes into img (channels as the file has them, palettes and tRNS expanded
+// as stb_image does); false with src.error set on failure.
+bool decode_png8(PngSource& src, int w, int h, Image& img) {
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &src, png_on_error, png_on_warning);
+    if (!png) {
+        std::snprintf(src.error, sizeof src.error, "out of memory");
+        return false;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (!info || setjmp(png_jmpbuf(png))) {
+        png_destroy_read_struct(&png, info ? &info : nullptr, nullptr);
+        if (!src.error[0]) std::snprintf(src.error, sizeof src.error, "out of memory");
+        return false;
+    }
+    png_set_read_fn(png, &src, png_read_memory);
+    // The header was checked already (sizes, the texel limit); keep libpng's
+    // own limits from refusing what stb_image accepts.
+    png_set_user_limits(png, 0x7FFFFFFF, 0x7FFFFFFF);
+    png_read_info(png, info);
+    if (int(png_get_image_width(png, info)) != w || int(png_get_image_height(png, info)) != h)
+        png_error(png, "inconsistent image header");
+    png_set_expand(png);  // palette -> RGB, grey < 8 bits -> 8, tRNS -> alpha
+    png_set_strip_16(png);
+    const int passes = png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+    const int channels = png_get_channels(png, info);
+    if (channels < 1 || channels > 4 || png_get_rowbytes(png, info) != std::size_t(w) * std::size_t(channels))
+        png_error(png, "unsupported pixel layout");
+    img.pixels.resize(std::size_t(w) * std::size_t(h) * std::size_t(channels));
+    const std::size_t stride = std::size_t(w) * std::size_t(channels);
+    for (int pass = 0; pass < passes; ++pass)
+        for (int y = 0; y < h; ++y) png_read_row(png, img.pixels.data() + std::size_t(y) * stride, nullptr);
+    png_destroy_read_struct(&png, &info, nullptr);
+    img.width = w;
+    img.height = h;
+    img.channels = channels;
+    return true;
+}
+
+} // namespace
+
+const float* srgb8_decode_table() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i) t[i] = srgb_to_linear(float(i) / 255.0f);
+        return t;
+    }();
+    return table.data();
+}
+
+const float* unorm8_decode_table() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i) t[i] = float(i) / 255.0f;
+        return t;
+    }();
+    return table.data();
+}
+
+namespace {
+
+// "" when stb_image 2.27 may see these bytes; else "cannot decode FORMAT
+// image: why".
+std::string stb_unsafe(const unsigned char* data, std::size_t size) {
+    std::string why;
+    if (looks_like_hdr(data, size)) {
+        int w = 0, h = 0;
+        why = check_hdr_data(data, size, w, h);
+        return why.empty() ? why : "cannot decode HDR image: " + why;
+    }
+    why = check_jpeg_data(data, size);
+    return why.empty() ? why : "cannot decode JPEG image: " + why;
+}
+
 } // namespace
 
 Image decode_image(const ImageSource& src, bool srgb) {
@@ -94,12 +416,10 @@ Image decode_image(const ImageSource& src, bool srgb) {
     const stbi_uc* data = bytes->data();
     const int len = int(bytes->size());
 
-    // Radiance data goes through the guard first: stb_image 2.27 can hang on it.
-    if (looks_like_hdr(data, bytes->size())) {
-        int hw = 0, hh = 0;
-        const std::string bad = check_hdr_data(data, bytes->size(), hw, hh);
-        if (!bad.empty()) throw LoadError(name + ": cannot decode HDR image: " + bad);
-    }
+    // Through the guards first: stb_image 2.27 can hang on Radiance data and
+    // write out of bounds on JPEG data (scene/hdr_guard.h, scene/jpeg_guard.h).
+    const std::string unsafe = stb_unsafe(data, bytes->size());
+    if (!unsafe.empty()) throw LoadError(name + ": " + unsafe);
 
     // Check the header before decoding anything: refuse absurd sizes up front.
     int w = 0, h = 0, comp = 0;
@@ -132,7 +452,6 @@ Image decode_image(const ImageSource& src, bool srgb) {
             throw LoadError(name + ": inconsistent image header");
         img.width = w;
         img.height = h;
-        img.rgba.resize(std::size_t(texels) * 4);
     };
     const std::size_t count = std::size_t(texels);
     const auto unit = [](float c) { return c; };
@@ -140,65 +459,75 @@ Image decode_image(const ImageSource& src, bool srgb) {
         // Radiance HDR: linear floats, kept as is whatever `srgb` says.
         std::unique_ptr<float, StbiFree> px(stbi_loadf_from_memory(data, len, &dw, &dh, &dcomp, 0));
         check(px.get());
+        img.rgba.resize(count * 4);
         expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), unit, unit);
     } else if (stbi_is_16_bit_from_memory(data, len)) {
         std::unique_ptr<stbi_us, StbiFree> px(stbi_load_16_from_memory(data, len, &dw, &dh, &dcomp, 0));
         check(px.get());
+        img.rgba.resize(count * 4);
         const auto linear = [](stbi_us c) { return float(c) / 65535.0f; };
         const auto decode = [](stbi_us c) { return srgb_to_linear(float(c) / 65535.0f); };
         if (srgb) expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), decode, linear);
         else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
+    } else if (sniff_format(data, bytes->size()) == std::string("PNG")) {
+        // 8-bit PNG: the bytes as the file has them; sampling decodes them.
+        std::string error;
+        const FastPng fast = decode_png_fast(data, bytes->size(), w, h, img, error);
+        if (fast == FastPng::Failed) throw LoadError(name + ": cannot decode PNG image: " + error);
+        if (fast == FastPng::NotMine) {
+            img = Image();
+            PngSource png{data, bytes->size(), 0, {0}};
+            if (!decode_png8(png, w, h, img)) throw LoadError(name + ": cannot decode PNG image: " + png.error);
+        }
+        img.srgb = srgb;
     } else {
+        // 8-bit: the bytes as the file has them; sampling decodes them.
         std::unique_ptr<stbi_uc, StbiFree> px(stbi_load_from_memory(data, len, &dw, &dh, &dcomp, 0));
         check(px.get());
-        const std::array<float, 256>& table = srgb_table();
-        const auto linear = [](stbi_uc c) { return float(c) / 255.0f; };
-        const auto decode = [&table](stbi_uc c) { return table[c]; };
-        if (srgb) expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), decode, linear);
-        else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
+        img.channels = dcomp;
+        img.srgb = srgb;
+        img.pixels.assign(px.get(), px.get() + count * std::size_t(dcomp));
     }
     return img;
 }
 
-namespace {
-
-// stb_image's callbacks over a file descriptor, for reading headers only.
-int fd_read(void* user, char* data, int size) {
-    for (;;) {
-        const ssize_t n = ::read(*static_cast<int*>(user), data, std::size_t(size));
-        if (n < 0 && errno == EINTR) continue;
-        return n < 0 ? 0 : int(n);
-    }
-}
-void fd_skip(void* user, int n) { ::lseek(*static_cast<int*>(user), n, SEEK_CUR); }
-int fd_eof(void* user) {
-    const int fd = *static_cast<int*>(user);
-    const off_t here = ::lseek(fd, 0, SEEK_CUR), end = ::lseek(fd, 0, SEEK_END);
-    ::lseek(fd, here, SEEK_SET);
-    return here >= end;
-}
-
-} // namespace
-
-bool image_dimensions(const ImageSource& src, int& width, int& height) {
-    int comp = 0;
+bool image_dimensions(const ImageSource& src, int& width, int& height, int* bytes_per_texel) {
     width = height = 0;
-    if (!src.bytes.empty()) {
-        if (src.bytes.size() > std::size_t(INT_MAX)) return false;
-        return stbi_info_from_memory(src.bytes.data(), int(src.bytes.size()), &width, &height, &comp) != 0;
+    // The header is within the first MiB of any file the project reads (a
+    // JPEG's frame header follows its EXIF and ICC segments, 64 KiB each).
+    constexpr std::size_t kHeaderBytes = std::size_t(1) << 20;
+    std::vector<unsigned char> head;
+    const std::vector<unsigned char>* bytes = &src.bytes;
+    if (src.bytes.empty()) {
+        if (src.path.empty()) return false;
+        std::uint64_t size = 0;
+        int fd = -1;
+        try {
+            fd = open_regular_file(src.path, src.name, size);
+        } catch (const LoadError&) {
+            return false;
+        }
+        head.resize(std::size_t(std::min<std::uint64_t>(size, kHeaderBytes)));
+        std::size_t got = 0;
+        while (got < head.size()) {
+            const ssize_t n = ::read(fd, head.data() + got, head.size() - got);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) break;
+            got += std::size_t(n);
+        }
+        ::close(fd);
+        head.resize(got);
+        bytes = &head;
     }
-    if (src.path.empty()) return false;
-    std::uint64_t size = 0;
-    int fd = -1;
-    try {
-        fd = open_regular_file(src.path, src.name, size);
-    } catch (const LoadError&) {
-        return false;
-    }
-    const stbi_io_callbacks io{fd_read, fd_skip, fd_eof};
-    const int ok = stbi_info_from_callbacks(&io, &fd, &width, &height, &comp);
-    ::close(fd);
-    return ok != 0;
+    if (bytes->empty() || bytes->size() > std::size_t(INT_MAX)) return false;
+    const stbi_uc* data = bytes->data();
+    const int len = int(bytes->size());
+    if (!stb_unsafe(data, bytes->size()).empty()) return false;  // stbi_info reads the tables too
+    int comp = 0;
+    if (!stbi_info_from_memory(data, len, &width, &height, &comp)) return false;
+    if (bytes_per_texel)
+        *bytes_per_texel = stbi_is_hdr_from_memory(data, len) || stbi_is_16_bit_from_memory(data, len) ? 16 : comp;
+    return true;
 }
 
 } // namespace prast

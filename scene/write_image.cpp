@@ -13,6 +13,8 @@
 
 #include <stb_image_write.h>
 
+#include "scene/encode_png.h"
+
 namespace prast {
 
 namespace {
@@ -88,10 +90,13 @@ std::vector<std::uint8_t> encode_png(int width, int height, const std::uint8_t* 
         rgb[i * 3 + 1] = rgba8[i * 4 + 1];
         rgb[i * 3 + 2] = rgba8[i * 4 + 2];
     }
-    std::vector<std::uint8_t> bytes;
-    if (!stbi_write_png_to_func(append_bytes, &bytes, width, height, 3, rgb.data(), width * 3))
-        throw WriteError("PNG encoding failed (stb_image_write ran out of memory)");
-    return bytes;
+    try {
+        return encode_png_pixels(rgb.data(), width, height, 3, png_options_threads());
+    } catch (const std::bad_alloc&) {
+        throw WriteError("PNG encoding failed: out of memory");
+    } catch (const std::exception& e) {
+        throw WriteError(std::string("PNG encoding failed: ") + e.what());
+    }
 }
 
 void remove_temporary_output() noexcept {

@@ -1,10 +1,23 @@
 #!/bin/sh
-# Installs the Debian 12 packages prast builds with (compiler, CMake and the
-# header-only libraries). Runs apt-get through sudo unless already root.
+# Installs the Debian 12 packages prast builds with (compiler, CMake, the
+# header-only libraries, and zlib and libpng, linked statically). Runs apt-get through sudo unless already root.
 set -e
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-PACKAGES="build-essential cmake libglm-dev libtinyobjloader-dev libstb-dev doctest-dev libtinygltf-dev nlohmann-json3-dev"
+PACKAGES="
+  build-essential
+  cmake
+  libglm-dev
+  libtinyobjloader-dev
+  libstb-dev
+  doctest-dev
+  libtinygltf-dev
+  nlohmann-json3-dev
+  zlib1g-dev
+  libpng-dev
+  libcpp-httplib-dev
+  pkg-config
+"
 missing=""
 for p in $PACKAGES; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -2,10 +2,14 @@
 // steps: prepare_trilinear_lanes() turns the lanes' uv and their quads' lambda
 // into texel indices and filter weights (branch-free loops over lanes, which
 // the compiler vectorises), and fetch_trilinear_lanes() reads and blends the
-// texels of the live lanes only (one 4-channel vector per texel). Every lane
-// performs exactly the float operations of Texture::sample_trilinear() in the
-// same order, so the two agree bit for bit (tests/test_sample_lanes.cpp); the
-// stepper and the debug views keep using the scalar sampler.
+// texels. 8-bit textures are read 8 (or 4) lanes per instruction: an AVX2
+// gather of each tap's packed texel bytes, the channels unpacked and turned
+// into floats (a gather from the sRGB table, or a division by 255), then the
+// bilinear and trilinear blends across lanes. Float textures are read one live
+// lane at a time (one 4-channel vector per texel). Every lane performs exactly
+// the float operations of Texture::sample_trilinear() in the same order, so
+// the two agree bit for bit (tests/test_sample_lanes.cpp); the stepper and the
+// debug views keep using the scalar sampler.
 //
 // The indices depend only on the level-0 size and the wrap modes, as does
 // lambda (Texture::lod), so textures with the same layout share one
@@ -19,6 +23,10 @@
 #include <cstring>
 
 #include <glm/glm.hpp>
+
+#ifdef __AVX2__
+#include <immintrin.h>
+#endif
 
 #include "raster/limits.h"
 #include "shading/texture.h"
@@ -121,20 +129,254 @@ inline void prepare_s(Wrap t, const float* u, const float* v, const LevelLanes& 
 // 4-channel float vector (one texel); lane-wise IEEE operations, no contraction.
 typedef float Float4 __attribute__((vector_size(16)));
 
-inline Float4 load_texel(const glm::vec4* texels, std::int32_t i) {
+// One texel of the chain as a 4-channel vector, whatever the storage.
+inline Float4 load_texel(const Texture& tex, std::int32_t i) {
     Float4 r;
-    std::memcpy(&r, &texels[i], sizeof r);
+    if (!tex.is_unorm8()) {
+        std::memcpy(&r, &tex.texel_data()[i], sizeof r);
+    } else {
+        const glm::vec4 t = tex.texel_at(std::size_t(i));
+        r = Float4{t.r, t.g, t.b, t.a};
+    }
     return r;
 }
 
-inline Float4 bilinear(const glm::vec4* texels, const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty,
+inline Float4 bilinear(const Texture& tex, const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty,
                        int l) {
-    const Float4 a = load_texel(texels, idx[0][l]), b = load_texel(texels, idx[1][l]);
-    const Float4 c = load_texel(texels, idx[2][l]), d = load_texel(texels, idx[3][l]);
+    const Float4 a = load_texel(tex, idx[0][l]), b = load_texel(tex, idx[1][l]);
+    const Float4 c = load_texel(tex, idx[2][l]), d = load_texel(tex, idx[3][l]);
     const Float4 top = a + (b - a) * tx[l];
     const Float4 bottom = c + (d - c) * tx[l];
     return top + (bottom - top) * ty[l];
 }
+
+// The live lanes one at a time, for K textures of any storage.
+template <int N, int K>
+inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLanes& at, TexelLanes* const* out) {
+    if (at.live != (1u << N) - 1u) {
+        for (int k = 0; k < K; ++k)
+            for (int l = 0; l < N; ++l) out[k]->r[l] = out[k]->g[l] = out[k]->b[l] = out[k]->a[l] = 0.0f;
+    }
+    for (std::uint32_t m = at.live; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        Float4 c[K];
+        for (int k = 0; k < K; ++k) c[k] = bilinear(*tex[k], at.ia, at.txa, at.tya, l);
+        if ((at.blend >> l) & 1u) {
+            for (int k = 0; k < K; ++k) {
+                const Float4 cb = bilinear(*tex[k], at.ib, at.txb, at.tyb, l);
+                c[k] = c[k] + (cb - c[k]) * at.t[l];
+            }
+        }
+        for (int k = 0; k < K; ++k) {
+            out[k]->r[l] = c[k][0];
+            out[k]->g[l] = c[k][1];
+            out[k]->b[l] = c[k][2];
+            out[k]->a[l] = c[k][3];
+        }
+    }
+}
+
+template <int N>
+inline void fetch_lanes_one_by_one(const Texture* const* tex, int count, const TrilinearLanes& at,
+                                   TexelLanes* const* out) {
+    for (; count >= 3; count -= 3, tex += 3, out += 3) fetch_lanes_one_by_one<N, 3>(tex, at, out);
+    if (count == 2) fetch_lanes_one_by_one<N, 2>(tex, at, out);
+    if (count == 1) fetch_lanes_one_by_one<N, 1>(tex, at, out);
+}
+
+#ifdef __AVX2__
+
+// W lanes per instruction: 8 (ymm) or 4 (xmm).
+template <int W> struct Simd;
+
+template <> struct Simd<8> {
+    using F = __m256;
+    using I = __m256i;
+    static I load_i(const std::int32_t* p) { return _mm256_load_si256(reinterpret_cast<const __m256i*>(p)); }
+    static F load_f(const float* p) { return _mm256_load_ps(p); }
+    static void store_f(float* p, F v) { _mm256_store_ps(p, v); }
+    static I set1_i(int v) { return _mm256_set1_epi32(v); }
+    static F set1_f(float v) { return _mm256_set1_ps(v); }
+    static F zero_f() { return _mm256_setzero_ps(); }
+    static I lane_bits() { return _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128); }
+    template <int Scale> static I gather_i(const std::uint8_t* base, I idx) {
+        return _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale);
+    }
+    static F gather_f(const float* table, I idx) { return _mm256_i32gather_ps(table, idx, 4); }
+    static I add_i(I a, I b) { return _mm256_add_epi32(a, b); }
+    static I and_i(I a, I b) { return _mm256_and_si256(a, b); }
+    static I srlv_i(I a, I n) { return _mm256_srlv_epi32(a, n); }
+    static I cmpeq_i(I a, I b) { return _mm256_cmpeq_epi32(a, b); }
+    static F cvt(I a) { return _mm256_cvtepi32_ps(a); }
+    static F add(F a, F b) { return _mm256_add_ps(a, b); }
+    static F sub(F a, F b) { return _mm256_sub_ps(a, b); }
+    static F mul(F a, F b) { return _mm256_mul_ps(a, b); }
+    static F div(F a, F b) { return _mm256_div_ps(a, b); }
+    static F select(F mask, F yes, F no) { return _mm256_blendv_ps(no, yes, mask); }
+    static F as_f(I a) { return _mm256_castsi256_ps(a); }
+};
+
+template <> struct Simd<4> {
+    using F = __m128;
+    using I = __m128i;
+    static I load_i(const std::int32_t* p) { return _mm_load_si128(reinterpret_cast<const __m128i*>(p)); }
+    static F load_f(const float* p) { return _mm_load_ps(p); }
+    static void store_f(float* p, F v) { _mm_store_ps(p, v); }
+    static I set1_i(int v) { return _mm_set1_epi32(v); }
+    static F set1_f(float v) { return _mm_set1_ps(v); }
+    static F zero_f() { return _mm_setzero_ps(); }
+    static I lane_bits() { return _mm_setr_epi32(1, 2, 4, 8); }
+    template <int Scale> static I gather_i(const std::uint8_t* base, I idx) {
+        return _mm_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale);
+    }
+    static F gather_f(const float* table, I idx) { return _mm_i32gather_ps(table, idx, 4); }
+    static I add_i(I a, I b) { return _mm_add_epi32(a, b); }
+    static I and_i(I a, I b) { return _mm_and_si128(a, b); }
+    static I srlv_i(I a, I n) { return _mm_srlv_epi32(a, n); }
+    static I cmpeq_i(I a, I b) { return _mm_cmpeq_epi32(a, b); }
+    static F cvt(I a) { return _mm_cvtepi32_ps(a); }
+    static F add(F a, F b) { return _mm_add_ps(a, b); }
+    static F sub(F a, F b) { return _mm_sub_ps(a, b); }
+    static F mul(F a, F b) { return _mm_mul_ps(a, b); }
+    static F div(F a, F b) { return _mm_div_ps(a, b); }
+    static F select(F mask, F yes, F no) { return _mm_blendv_ps(no, yes, mask); }
+    static F as_f(I a) { return _mm_castsi128_ps(a); }
+};
+
+// The packed bytes of texel idx (C bytes each, 4 read) for W lanes.
+template <class V, int C>
+inline typename V::I gather_texels(const std::uint8_t* base, typename V::I idx) {
+    if constexpr (C == 4) return V::template gather_i<4>(base, idx);
+    if constexpr (C == 2) return V::template gather_i<2>(base, idx);
+    if constexpr (C == 1) return V::template gather_i<1>(base, idx);
+    return V::template gather_i<1>(base, V::add_i(idx, V::add_i(idx, idx)));  // 3 idx
+}
+
+// Stored channel c of the words as floats, through its table.
+template <class V>
+inline typename V::F decode_channel(typename V::I words, int c, const float* table, bool divide) {
+    const typename V::I byte = V::and_i(V::srlv_i(words, V::set1_i(8 * c)), V::set1_i(0xFF));
+    if (divide) return V::div(V::cvt(byte), V::set1_f(255.0f));  // == unorm8_decode_table()[byte]
+    return V::gather_f(table, byte);
+}
+
+// Bilinear filter of every stored channel of one level for lanes [l0, l0 + W).
+template <class V, int C>
+inline void bilinear_unorm8(const Texture& tex, const bool* divide, const std::int32_t (*idx)[kMaxN],
+                            const float* tx_lanes, const float* ty_lanes, int l0, typename V::F* result) {
+    using F = typename V::F;
+    const std::uint8_t* base = tex.unorm8_data();
+    const typename V::I wa = gather_texels<V, C>(base, V::load_i(idx[0] + l0));
+    const typename V::I wb = gather_texels<V, C>(base, V::load_i(idx[1] + l0));
+    const typename V::I wc = gather_texels<V, C>(base, V::load_i(idx[2] + l0));
+    const typename V::I wd = gather_texels<V, C>(base, V::load_i(idx[3] + l0));
+    const F tx = V::load_f(tx_lanes + l0), ty = V::load_f(ty_lanes + l0);
+    for (int c = 0; c < C; ++c) {
+        const float* table = tex.table(c);
+        const F a = decode_channel<V>(wa, c, table, divide[c]), b = decode_channel<V>(wb, c, table, divide[c]);
+        const F cc = decode_channel<V>(wc, c, table, divide[c]), d = decode_channel<V>(wd, c, table, divide[c]);
+        // top = a + (b - a) tx; bottom = c + (d - c) tx; top + (bottom - top) ty.
+        const F top = V::add(a, V::mul(V::sub(b, a), tx));
+        const F bottom = V::add(cc, V::mul(V::sub(d, cc), tx));
+        result[c] = V::add(top, V::mul(V::sub(bottom, top), ty));
+    }
+}
+
+// All N lanes of an 8-bit texture, W at a time; non-live lanes get 0.
+template <int N, int W, int C>
+inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+    using V = Simd<W>;
+    using F = typename V::F;
+    bool divide[4];
+    for (int c = 0; c < C; ++c) divide[c] = tex.table(c) == unorm8_decode_table();
+    float* dst[4] = {out.r, out.g, out.b, out.a};
+    for (int l0 = 0; l0 < N; l0 += W) {
+        const unsigned live = (at.live >> l0) & ((1u << W) - 1u);
+        if (!live) {
+            for (int k = 0; k < 4; ++k) V::store_f(dst[k] + l0, V::zero_f());
+            continue;
+        }
+        F res[4];
+        bilinear_unorm8<V, C>(tex, divide, at.ia, at.txa, at.tya, l0, res);
+        const unsigned blend = (at.blend >> l0) & ((1u << W) - 1u);
+        if (blend) {
+            F resb[4];
+            bilinear_unorm8<V, C>(tex, divide, at.ib, at.txb, at.tyb, l0, resb);
+            const F t = V::load_f(at.t + l0);
+            const F mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits()));
+            for (int c = 0; c < C; ++c) res[c] = V::select(mask, V::add(res[c], V::mul(V::sub(resb[c], res[c]), t)), res[c]);
+        }
+        const F live_mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(live)), V::lane_bits()), V::lane_bits()));
+        const F zero = V::zero_f();
+        for (int k = 0; k < 4; ++k) {
+            const int sw = tex.swizzle(k);
+            const F v = sw == Texture::kOne ? V::set1_f(1.0f) : res[sw];
+            V::store_f(dst[k] + l0, V::select(live_mask, v, zero));
+        }
+    }
+}
+
+// The stored channels of one 8-bit texel (index i) as a vector, through
+// their tables; channels past C are 0 (never written out).
+template <int C>
+inline Float4 load_unorm8_texel(const std::uint8_t* base, const float* const* table, std::int32_t i) {
+    const std::uint8_t* p = base + std::size_t(i) * C;
+    Float4 r = {0.0f, 0.0f, 0.0f, 0.0f};
+    r[0] = table[0][p[0]];
+    if constexpr (C > 1) r[1] = table[1][p[1]];
+    if constexpr (C > 2) r[2] = table[2][p[2]];
+    if constexpr (C > 3) r[3] = table[3][p[3]];
+    return r;
+}
+
+template <int C>
+inline Float4 bilinear_unorm8_lane(const std::uint8_t* base, const float* const* table,
+                                   const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty, int l) {
+    const Float4 a = load_unorm8_texel<C>(base, table, idx[0][l]), b = load_unorm8_texel<C>(base, table, idx[1][l]);
+    const Float4 c = load_unorm8_texel<C>(base, table, idx[2][l]), d = load_unorm8_texel<C>(base, table, idx[3][l]);
+    const Float4 top = a + (b - a) * tx[l];
+    const Float4 bottom = c + (d - c) * tx[l];
+    return top + (bottom - top) * ty[l];
+}
+
+// The live lanes of an 8-bit texture one at a time (sparse blocks: the
+// gathers would fetch the dead lanes too). The same operations per channel.
+template <int N, int C>
+inline void fetch_unorm8_one_by_one(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+    const float* table[4] = {tex.table(0), tex.table(C > 1 ? 1 : 0), tex.table(C > 2 ? 2 : 0), tex.table(C > 3 ? 3 : 0)};
+    const std::uint8_t* base = tex.unorm8_data();
+    float* dst[4] = {out.r, out.g, out.b, out.a};
+    int sw[4];
+    for (int k = 0; k < 4; ++k) sw[k] = tex.swizzle(k);
+    if (at.live != (1u << N) - 1u)
+        for (int l = 0; l < N; ++l) out.r[l] = out.g[l] = out.b[l] = out.a[l] = 0.0f;
+    for (std::uint32_t m = at.live; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        Float4 c = bilinear_unorm8_lane<C>(base, table, at.ia, at.txa, at.tya, l);
+        if ((at.blend >> l) & 1u) {
+            const Float4 cb = bilinear_unorm8_lane<C>(base, table, at.ib, at.txb, at.tyb, l);
+            c = c + (cb - c) * at.t[l];
+        }
+        for (int k = 0; k < 4; ++k) dst[k][l] = sw[k] == Texture::kOne ? 1.0f : c[sw[k] & 3];
+    }
+}
+
+// Blocks with at most this many live lanes read them one by one.
+constexpr int kSparseLanes = 4;
+
+template <int N>
+inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+    constexpr int W = N >= 8 ? 8 : 4;
+    const bool sparse = __builtin_popcount(at.live) <= kSparseLanes;
+    switch (tex.channels()) {
+    case 1: sparse ? fetch_unorm8_one_by_one<N, 1>(tex, at, out) : fetch_unorm8_lanes<N, W, 1>(tex, at, out); return;
+    case 2: sparse ? fetch_unorm8_one_by_one<N, 2>(tex, at, out) : fetch_unorm8_lanes<N, W, 2>(tex, at, out); return;
+    case 3: sparse ? fetch_unorm8_one_by_one<N, 3>(tex, at, out) : fetch_unorm8_lanes<N, W, 3>(tex, at, out); return;
+    default: sparse ? fetch_unorm8_one_by_one<N, 4>(tex, at, out) : fetch_unorm8_lanes<N, W, 4>(tex, at, out); return;
+    }
+}
+
+#endif // __AVX2__
 
 } // namespace sample_lanes_detail
 
@@ -227,52 +469,42 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
     }
 }
 
-// Filters the live lanes of `at` from the K textures tex[k] (all of the layout
-// the lanes were prepared for) into out[k]; the other lanes of the first N
-// are set to 0. One pass over the lanes for all K: the indices and weights are
-// read once and the texel loads of the textures overlap.
-template <int N, int K>
-inline void fetch_trilinear_lanes(const Texture* const* tex, const TrilinearLanes& at, TexelLanes* const* out) {
-    using namespace sample_lanes_detail;
-    if (at.live != (1u << N) - 1u) {
-        for (int k = 0; k < K; ++k)
-            for (int l = 0; l < N; ++l) out[k]->r[l] = out[k]->g[l] = out[k]->b[l] = out[k]->a[l] = 0.0f;
-    }
-    const glm::vec4* texels[K];
-    for (int k = 0; k < K; ++k) texels[k] = tex[k]->texel_data();
-    for (std::uint32_t m = at.live; m; m &= m - 1) {
-        const int l = __builtin_ctz(m);
-        Float4 c[K];
-        for (int k = 0; k < K; ++k) c[k] = bilinear(texels[k], at.ia, at.txa, at.tya, l);
-        if ((at.blend >> l) & 1u) {
-            for (int k = 0; k < K; ++k) {
-                const Float4 cb = bilinear(texels[k], at.ib, at.txb, at.tyb, l);
-                c[k] = c[k] + (cb - c[k]) * at.t[l];
-            }
-        }
-        for (int k = 0; k < K; ++k) {
-            out[k]->r[l] = c[k][0];
-            out[k]->g[l] = c[k][1];
-            out[k]->b[l] = c[k][2];
-            out[k]->a[l] = c[k][3];
-        }
-    }
-}
-
-// Any number of textures, up to three per pass.
+// Filters the live lanes of `at` from the `count` textures tex[k] (all of the
+// layout the lanes were prepared for) into out[k]; the other lanes of the
+// first N are set to 0. 8-bit textures go through the gathers (AVX2 builds);
+// float ones are read lane by lane, up to three per pass so that the indices
+// and weights are read once and the texel loads of the textures overlap.
 template <int N = kBlockLanes>
 inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const TrilinearLanes& at,
                                   TexelLanes* const* out) {
-    for (; count >= 3; count -= 3, tex += 3, out += 3) fetch_trilinear_lanes<N, 3>(tex, at, out);
-    if (count == 2) fetch_trilinear_lanes<N, 2>(tex, at, out);
-    if (count == 1) fetch_trilinear_lanes<N, 1>(tex, at, out);
+    using namespace sample_lanes_detail;
+#ifdef __AVX2__
+    const Texture* rest[3];
+    TexelLanes* rest_out[3];
+    int n_rest = 0;
+    for (int k = 0; k < count; ++k) {
+        if (tex[k]->is_unorm8()) {
+            fetch_unorm8_lanes<N>(*tex[k], at, *out[k]);
+            continue;
+        }
+        rest[n_rest] = tex[k];
+        rest_out[n_rest++] = out[k];
+        if (n_rest == 3) {
+            fetch_lanes_one_by_one<N, 3>(rest, at, rest_out);
+            n_rest = 0;
+        }
+    }
+    fetch_lanes_one_by_one<N>(rest, n_rest, at, rest_out);
+#else
+    fetch_lanes_one_by_one<N>(tex, count, at, out);
+#endif
 }
 
 template <int N = kBlockLanes>
 inline void fetch_trilinear_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
     const Texture* t = &tex;
     TexelLanes* o = &out;
-    fetch_trilinear_lanes<N, 1>(&t, at, &o);
+    fetch_trilinear_lanes<N>(&t, 1, at, &o);
 }
 
 } // namespace prast

@@ -32,66 +32,126 @@ std::vector<ShadingLight> default_light_rig() {
 }
 
 SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(scene), renderer_(renderer) {
-    // Which (image, colour space) pairs the materials need.
+    // Which (image, colour space) pairs the materials need, slot image * 2 + srgb.
     const std::size_t n_images = scene.images.size();
-    std::vector<char> needed(n_images * 2, 0);
-    auto want = [&](const TextureRef& r, bool srgb) {
-        if (r.valid() && std::size_t(r.image) < n_images) needed[std::size_t(r.image) * 2 + srgb] = 1;
+    auto slot_of = [&](const TextureRef& r, bool srgb) -> int {
+        return r.valid() && std::size_t(r.image) < n_images ? r.image * 2 + int(srgb) : -1;
     };
-    for (const Material& m : scene.materials) {
-        want(m.base_color, true);
-        want(m.emissive, true);
-        want(m.metallic_roughness, false);
-        want(m.roughness, false);
-        want(m.metallic, false);
-        want(m.normal, false);
-        want(m.occlusion, false);
+    // Wrap modes live on the reference; an image takes its first user's.
+    std::vector<const TextureRef*> first_user(n_images, nullptr);
+    for (const Material& m : scene.materials)
+        for (const TextureRef* r : {&m.base_color, &m.emissive, &m.metallic_roughness, &m.roughness, &m.metallic,
+                                    &m.normal, &m.occlusion})
+            if (r->valid() && std::size_t(r->image) < n_images && !first_user[std::size_t(r->image)])
+                first_user[std::size_t(r->image)] = r;
+    auto wraps_of = [&](int slot) {
+        const TextureRef* u = first_user[std::size_t(slot / 2)];
+        return std::make_pair(u ? u->wrap_s : Wrap::Repeat, u ? u->wrap_t : Wrap::Repeat);
+    };
+
+    // Separate roughness and metal maps (OBJ map_Pr + map_Pm) are packed into
+    // one texture, one lookup instead of two, when they sample alike (same
+    // wrap modes here, same size and 8-bit grey once decoded).
+    std::vector<char> direct(n_images * 2, 0);
+    std::vector<std::pair<int, int>> packs;            // (roughness slot, metal slot)
+    std::vector<int> material_pack(scene.materials.size(), -1);
+    for (std::size_t mi = 0; mi < scene.materials.size(); ++mi) {
+        const Material& m = scene.materials[mi];
+        for (auto [r, srgb] : {std::pair{&m.base_color, true}, {&m.emissive, true}, {&m.metallic_roughness, false},
+                               {&m.normal, false}, {&m.occlusion, false}})
+            if (slot_of(*r, srgb) >= 0) direct[std::size_t(slot_of(*r, srgb))] = 1;
+        const int rs = slot_of(m.roughness, false), ms = slot_of(m.metallic, false);
+        if (rs >= 0 && ms >= 0 && rs != ms && !m.metallic_roughness.valid() && wraps_of(rs) == wraps_of(ms)) {
+            const auto key = std::make_pair(rs, ms);
+            auto it = std::find(packs.begin(), packs.end(), key);
+            material_pack[mi] = int(it - packs.begin());
+            if (it == packs.end()) packs.push_back(key);
+        } else {
+            if (rs >= 0) direct[std::size_t(rs)] = 1;
+            if (ms >= 0) direct[std::size_t(ms)] = 1;
+        }
     }
-    // Decode in parallel; each task owns its slot, so the result is the same
-    // for any thread count. Failures become warnings in image order.
+    std::vector<char> needed = direct;
+    for (const auto& [rs, ms] : packs) needed[std::size_t(rs)] = needed[std::size_t(ms)] = 1;
+
+    // Decode in parallel, one task per image; each task owns its slot, so the
+    // result is the same for any thread count. Failures become warnings in
+    // image order.
     textures_.resize(needed.size());
     std::vector<std::string> errors(needed.size());
+    std::vector<Image> images(needed.size());
+    std::vector<char> decoded(needed.size(), 0);
     std::vector<int> slots;
     for (std::size_t i = 0; i < needed.size(); ++i)
         if (needed[i]) slots.push_back(int(i));
     renderer.pool().run(int(slots.size()), [&](int task, int) {
-        std::size_t slot = std::size_t(slots[std::size_t(task)]);
+        const std::size_t slot = std::size_t(slots[std::size_t(task)]);
         const ImageSource& src = scene.images[slot / 2];
-        bool srgb = slot % 2 == 1;
         try {
-            Image img = src.decoded ? *src.decoded : decode_image(src, srgb);
-            // Wrap modes live on the reference; the first user's are used.
-            auto first_user = [&]() -> const TextureRef* {
-                for (const Material& m : scene.materials)
-                    for (const TextureRef* r : {&m.base_color, &m.emissive, &m.metallic_roughness, &m.roughness,
-                                                &m.metallic, &m.normal, &m.occlusion})
-                        if (std::size_t(r->image) == slot / 2) return r;
-                return nullptr;
-            };
-            const TextureRef* user = first_user();
-            Wrap ws = user ? user->wrap_s : Wrap::Repeat, wt = user ? user->wrap_t : Wrap::Repeat;
-            textures_[slot] = std::make_unique<Texture>(Texture::from_image(std::move(img), ws, wt));
+            images[slot] = src.decoded ? *src.decoded : decode_image(src, slot % 2 == 1);
+            decoded[slot] = 1;
         } catch (const std::bad_alloc&) {
             errors[slot] = (src.name.empty() ? src.path : src.name) + ": out of memory while decoding";
         } catch (const std::exception& e) {
             errors[slot] = e.what();
         }
     });
+
+    // Packs whose maps decoded alike; the others fall back to separate maps.
+    std::vector<char> pack_ok(packs.size(), 0);
+    for (std::size_t p = 0; p < packs.size(); ++p) {
+        const std::size_t rs = std::size_t(packs[p].first), ms = std::size_t(packs[p].second);
+        const Image& r = images[rs];
+        const Image& m = images[ms];
+        pack_ok[p] = decoded[rs] && decoded[ms] && r.is_8bit() && m.is_8bit() && !r.srgb && !m.srgb &&
+                     r.width == m.width && r.height == m.height;
+        if (!pack_ok[p]) direct[rs] = direct[ms] = 1;
+    }
+
+    // Mip chains, each level's rows in parallel on the pool.
+    packed_.resize(packs.size());
+    for (std::size_t p = 0; p < packs.size(); ++p) {
+        if (!pack_ok[p]) continue;
+        const auto [ws, wt] = wraps_of(packs[p].first);
+        packed_[p] = std::make_unique<Texture>(Texture::pack_roughness_metal(
+            images[std::size_t(packs[p].first)], images[std::size_t(packs[p].second)], ws, wt, &renderer.pool()));
+    }
+    for (std::size_t slot = 0; slot < needed.size(); ++slot) {
+        if (!decoded[slot] || !direct[slot]) continue;
+        const auto [ws, wt] = wraps_of(int(slot));
+        try {
+            textures_[slot] = std::make_unique<Texture>(
+                Texture::from_image(std::move(images[slot]), ws, wt, &renderer.pool()));
+        } catch (const std::bad_alloc&) {
+            const ImageSource& src = scene.images[slot / 2];
+            errors[slot] = (src.name.empty() ? src.path : src.name) + ": out of memory while building its mip maps";
+        } catch (const std::exception& e) {
+            errors[slot] = e.what();
+        }
+        images[slot] = Image();
+    }
+    images.clear();
     for (const std::string& e : errors)
         if (!e.empty()) warnings_.push_back(e + " (texture ignored)");
 
     auto bind = [&](const TextureRef& r, bool srgb) -> const Texture* {
-        if (!r.valid() || std::size_t(r.image) >= n_images) return nullptr;
-        return textures_[std::size_t(r.image) * 2 + srgb].get();
+        const int slot = slot_of(r, srgb);
+        return slot >= 0 ? textures_[std::size_t(slot)].get() : nullptr;
     };
-    for (const Material& m : scene.materials) {
+    for (std::size_t mi = 0; mi < scene.materials.size(); ++mi) {
+        const Material& m = scene.materials[mi];
         BoundMaterial b;
         b.m = &m;
         b.base_color = bind(m.base_color, true);
         b.emissive = bind(m.emissive, true);
         b.metallic_roughness = bind(m.metallic_roughness, false);
-        b.roughness = bind(m.roughness, false);
-        b.metallic = bind(m.metallic, false);
+        const int p = material_pack[mi];
+        if (p >= 0 && pack_ok[std::size_t(p)]) {
+            b.metallic_roughness = packed_[std::size_t(p)].get();  // G rough, B metal
+        } else {
+            b.roughness = bind(m.roughness, false);
+            b.metallic = bind(m.metallic, false);
+        }
         b.normal = bind(m.normal, false);
         b.occlusion = bind(m.occlusion, false);
         bound_.push_back(b);

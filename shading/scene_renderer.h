@@ -51,6 +51,7 @@ private:
     const Scene& scene_;
     Renderer& renderer_;
     std::vector<std::unique_ptr<Texture>> textures_;  // [image * 2 + srgb]
+    std::vector<std::unique_ptr<Texture>> packed_;    // OBJ roughness + metal pairs
     std::vector<BoundMaterial> bound_;
     std::vector<std::string> warnings_;
 };

@@ -1,10 +1,18 @@
-// Texture: the box-filtered mip chain and the sampler tables; the samplers
-// themselves are inline in texture.h.
+// Texture: the box-filtered mip chains (float, and 8-bit with exact rounding)
+// and the sampler tables; the samplers themselves are inline in texture.h.
 #include "shading/texture.h"
 
 #include <algorithm>
+#include <array>
+#include <cstring>
 #include <stdexcept>
 #include <string>
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
+#include "raster/thread_pool.h"
 
 namespace prast {
 
@@ -43,17 +51,20 @@ BoxTaps box_taps(int n, int i) {
     return t;
 }
 
-// Separable area filter: rows first into `tmp`, then columns into dst.
-void downsample(const glm::vec4* src, int sw, int sh, glm::vec4* dst, int dw, int dh,
+// Separable area filter for output rows [j0, j1): the source rows they need
+// filtered horizontally into `tmp`, then columns into dst. Each output texel
+// sees the same operations whichever rows a call covers.
+void downsample(const glm::vec4* src, int sw, int sh, glm::vec4* dst, int dw, int j0, int j1,
                 std::vector<glm::vec4>& tmp) {
-    std::vector<BoxTaps> tx(static_cast<std::size_t>(dw)), ty(static_cast<std::size_t>(dh));
+    std::vector<BoxTaps> tx(static_cast<std::size_t>(dw));
     for (int i = 0; i < dw; ++i) tx[i] = box_taps(sw, i);
-    for (int j = 0; j < dh; ++j) ty[j] = box_taps(sh, j);
-
-    tmp.assign(std::size_t(dw) * std::size_t(sh), glm::vec4(0.0f));
-    for (int y = 0; y < sh; ++y) {
+    const int y0 = box_taps(sh, j0).first;
+    const BoxTaps last = box_taps(sh, j1 - 1);
+    const int y1 = last.first + last.count;
+    tmp.resize(std::size_t(dw) * std::size_t(y1 - y0));
+    for (int y = y0; y < y1; ++y) {
         const glm::vec4* row = src + std::size_t(y) * std::size_t(sw);
-        glm::vec4* out = tmp.data() + std::size_t(y) * std::size_t(dw);
+        glm::vec4* out = tmp.data() + std::size_t(y - y0) * std::size_t(dw);
         for (int i = 0; i < dw; ++i) {
             const BoxTaps& t = tx[i];
             glm::vec4 sum(0.0f);
@@ -61,15 +72,174 @@ void downsample(const glm::vec4* src, int sw, int sh, glm::vec4* dst, int dw, in
             out[i] = sum;
         }
     }
-    for (int j = 0; j < dh; ++j) {
-        const BoxTaps& t = ty[j];
+    for (int j = j0; j < j1; ++j) {
+        const BoxTaps t = box_taps(sh, j);
         glm::vec4* out = dst + std::size_t(j) * std::size_t(dw);
         for (int i = 0; i < dw; ++i) out[i] = glm::vec4(0.0f);
         for (int k = 0; k < t.count; ++k) {
-            const glm::vec4* row = tmp.data() + std::size_t(t.first + k) * std::size_t(dw);
+            const glm::vec4* row = tmp.data() + std::size_t(t.first + k - y0) * std::size_t(dw);
             for (int i = 0; i < dw; ++i) out[i] += row[i] * t.weight[k];
         }
     }
+}
+
+// ---- 8-bit mips.
+
+// The integer form of box_taps(): weights k[i] over the common denominator d
+// (2 for even sizes, n for odd ones, 1 for a size of 1).
+struct IntTaps {
+    int first = 0, count = 0;
+    std::int64_t k[3] = {0, 0, 0};
+    std::int64_t d = 1;
+};
+
+IntTaps int_taps(int n, int i) {
+    IntTaps t;
+    if (n == 1) {
+        t.count = 1;
+        t.k[0] = 1;
+    } else if (n % 2 == 0) {
+        t.first = 2 * i;
+        t.count = 2;
+        t.k[0] = t.k[1] = 1;
+        t.d = 2;
+    } else {
+        const int m = n / 2;
+        t.first = 2 * i;
+        t.count = 3;
+        t.k[0] = m - i;
+        t.k[1] = m;
+        t.k[2] = i + 1;
+        t.d = n;
+    }
+    return t;
+}
+
+// Re-encoding linear values to sRGB bytes, correctly rounded: byte b is the
+// number of thresholds T_k = decode((k + 0.5) / 255), k = 0..254, at or below
+// the value (ties round up), with decode the exact sRGB transfer function in
+// double. A 4097-entry table of the answer at i / 4096 gives the start of a
+// search that then steps up at most a couple of times.
+struct SrgbEncoder {
+    double threshold[256];      // [255] = +inf, a sentinel
+    std::uint8_t start[4097];
+
+    SrgbEncoder() {
+        for (int k = 0; k < 255; ++k) {
+            const double c = (double(k) + 0.5) / 255.0;
+            threshold[k] = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+        }
+        threshold[255] = HUGE_VAL;
+        int b = 0;
+        for (int i = 0; i <= 4096; ++i) {
+            while (b < 255 && double(i) / 4096.0 >= threshold[b]) ++b;
+            start[i] = std::uint8_t(b);
+        }
+    }
+    std::uint8_t encode(double linear) const {
+        const double x = linear < 0.0 ? 0.0 : (linear > 1.0 ? 1.0 : linear);
+        int b = start[int(x * 4096.0)];
+        while (x >= threshold[b]) ++b;
+        return std::uint8_t(b);
+    }
+};
+
+const SrgbEncoder& srgb_encoder() {
+    static const SrgbEncoder e;
+    return e;
+}
+
+// Output rows [j0, j1) of an 8-bit level from the level above, channel by
+// channel: linear channels exactly in integers (round half up), sRGB ones as
+// the area-weighted mean of the decoded values (in double: the weighted sum of
+// up to 9 floats is exact, then one division) re-encoded by SrgbEncoder.
+void downsample_unorm8(const std::uint8_t* src, int sw, int sh, std::uint8_t* dst, int dw, int j0, int j1,
+                       int channels, const bool* srgb_channel) {
+    const float* srgb = srgb8_decode_table();
+    const SrgbEncoder& enc = srgb_encoder();
+    const std::size_t C = std::size_t(channels);
+    std::vector<IntTaps> tx(static_cast<std::size_t>(dw));
+    for (int i = 0; i < dw; ++i) tx[i] = int_taps(sw, i);
+    for (int j = j0; j < j1; ++j) {
+        const IntTaps ty = int_taps(sh, j);
+        std::uint8_t* out = dst + std::size_t(j) * std::size_t(dw) * C;
+        const std::uint8_t* rows[3];
+        for (int b = 0; b < ty.count; ++b) rows[b] = src + std::size_t(ty.first + b) * std::size_t(sw) * C;
+        if (ty.count == 2 && sw % 2 == 0) {
+            // The common case, 2x2 texels of weight 1/4.
+            const std::uint8_t* r0 = rows[0];
+            const std::uint8_t* r1 = rows[1];
+            for (int i = 0; i < dw; ++i) {
+                const std::size_t a = std::size_t(2 * i) * C, b = a + C;
+                for (std::size_t c = 0; c < C; ++c) {
+                    if (srgb_channel[c]) {
+                        const double sum = double(srgb[r0[a + c]]) + double(srgb[r0[b + c]]) +
+                                           double(srgb[r1[a + c]]) + double(srgb[r1[b + c]]);
+                        out[std::size_t(i) * C + c] = enc.encode(sum / 4.0);
+                    } else {
+                        const int sum = r0[a + c] + r0[b + c] + r1[a + c] + r1[b + c];
+                        out[std::size_t(i) * C + c] = std::uint8_t((sum + 2) >> 2);
+                    }
+                }
+            }
+            continue;
+        }
+        for (int i = 0; i < dw; ++i) {
+            const IntTaps& t = tx[std::size_t(i)];
+            const std::int64_t d = t.d * ty.d;
+            for (std::size_t c = 0; c < C; ++c) {
+                if (srgb_channel[c]) {
+                    double sum = 0.0;
+                    for (int b = 0; b < ty.count; ++b)
+                        for (int a = 0; a < t.count; ++a)
+                            sum += double(ty.k[b] * t.k[a]) *
+                                   double(srgb[rows[b][std::size_t(t.first + a) * C + c]]);
+                    out[std::size_t(i) * C + c] = enc.encode(sum / double(d));
+                } else {
+                    std::int64_t sum = 0;
+                    for (int b = 0; b < ty.count; ++b)
+                        for (int a = 0; a < t.count; ++a)
+                            sum += ty.k[b] * t.k[a] * rows[b][std::size_t(t.first + a) * C + c];
+                    out[std::size_t(i) * C + c] = std::uint8_t((2 * sum + d) / (2 * d));
+                }
+            }
+        }
+    }
+}
+
+// Runs fn(j0, j1) over [0, rows) in chunks, on the pool when there is one and
+// the level is large enough to pay for it.
+template <class F>
+void for_row_chunks(ThreadPool* pool, int rows, std::size_t row_texels, F fn) {
+    const std::size_t texels = std::size_t(rows) * row_texels;
+    if (!pool || pool->size() == 1 || texels < 16384) {
+        fn(0, rows);
+        return;
+    }
+    const int chunks = std::min(rows, 8 * pool->size());
+    pool->run(chunks, [&](int c, int) {
+        const int j0 = int(std::int64_t(rows) * c / chunks), j1 = int(std::int64_t(rows) * (c + 1) / chunks);
+        if (j0 < j1) fn(j0, j1);
+    });
+}
+
+// Uninitialised memory for the 8-bit texels: large buffers are 2 MiB aligned
+// and advised as huge pages, so that filling them faults a few times, not
+// once per 4 KiB.
+std::uint8_t* allocate_texels(std::size_t bytes) {
+    constexpr std::size_t kHuge = std::size_t(2) << 20;
+    if (bytes >= kHuge) {
+        const std::size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
+        void* p = std::aligned_alloc(kHuge, rounded);
+        if (!p) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+        madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+        return static_cast<std::uint8_t*>(p);
+    }
+    void* p = std::malloc(bytes);
+    if (!p) throw std::bad_alloc();
+    return static_cast<std::uint8_t*>(p);
 }
 
 } // namespace
@@ -92,13 +262,46 @@ Texture::Texture() {
     texels_.assign(1, glm::vec4(1.0f));
     levels_[0] = Level{1, 1, 1.0f, 1.0f, 0};
     level_count_ = 1;
+    total_texels_ = 1;
+    memory_bytes_ = sizeof(glm::vec4);
 }
 
-Texture Texture::from_image(Image img, Wrap s, Wrap t) {
+void Texture::layout(int w, int h) {
+    int n = 0;
+    std::size_t total = 0;
+    for (;;) {
+        levels_[n] = Level{w, h, float(w), float(h), total};
+        total += std::size_t(w) * std::size_t(h);
+        ++n;
+        if (w == 1 && h == 1) break;
+        w = std::max(1, w / 2);
+        h = std::max(1, h / 2);
+    }
+    level_count_ = n;
+    total_texels_ = total;
+}
+
+Texture Texture::from_image(Image img, Wrap s, Wrap t, ThreadPool* pool) {
     if (img.empty())
         throw std::invalid_argument("Texture::from_image: empty image (" +
                                     std::to_string(img.width) + "x" + std::to_string(img.height) + ")");
-    const std::size_t count0 = std::size_t(img.width) * std::size_t(img.height);
+    const std::size_t count0 = img.texel_count();
+    if (img.is_8bit()) {
+        if (img.channels > 4 || img.pixels.size() != count0 * std::size_t(img.channels))
+            throw std::invalid_argument("Texture::from_image: " + std::to_string(img.channels) +
+                                        "-channel image holds " + std::to_string(img.pixels.size()) +
+                                        " bytes, expected " + std::to_string(count0 * std::size_t(img.channels)));
+        // Grey and grey+alpha replicate their first channel to r, g, b.
+        static const int kSwizzle[5][4] = {
+            {0, 1, 2, 3}, {0, 0, 0, kOne}, {0, 0, 0, 1}, {0, 1, 2, kOne}, {0, 1, 2, 3}};
+        const float* colour = img.srgb ? srgb8_decode_table() : unorm8_decode_table();
+        const float* linear = unorm8_decode_table();
+        const bool has_alpha = img.channels == 2 || img.channels == 4;
+        const float* tables[4] = {colour, colour, colour, colour};
+        if (has_alpha) tables[img.channels - 1] = linear;
+        return from_unorm8(img.pixels.data(), img.channels, tables, kSwizzle[img.channels], img.width,
+                           img.height, s, t, pool);
+    }
     if (img.rgba.size() != count0 * 4)
         throw std::invalid_argument("Texture::from_image: rgba holds " +
                                     std::to_string(img.rgba.size()) + " floats, expected " +
@@ -106,41 +309,83 @@ Texture Texture::from_image(Image img, Wrap s, Wrap t) {
     Texture tex;
     tex.wrap_s_ = s;
     tex.wrap_t_ = t;
-
-    // Lay out the chain: halve, round down, at least 1.
-    int w = img.width, h = img.height, n = 0;
-    std::size_t total = 0;
-    for (;;) {
-        tex.levels_[n] = Level{w, h, float(w), float(h), total};
-        total += std::size_t(w) * std::size_t(h);
-        ++n;
-        if (w == 1 && h == 1) break;
-        w = std::max(1, w / 2);
-        h = std::max(1, h / 2);
-    }
-    tex.level_count_ = n;
+    tex.layout(img.width, img.height);
 
     // Level 0 is the image; each further level is the box-filtered one above.
-    tex.texels_.assign(total, glm::vec4(0.0f));
-    for (std::size_t i = 0; i < count0; ++i)
-        tex.texels_[i] = glm::vec4(img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2],
-                                   img.rgba[4 * i + 3]);
-    img = Image();  // release the source before the chain needs its scratch row
-    std::vector<glm::vec4> tmp;
-    for (int l = 1; l < n; ++l) {
+    tex.texels_.resize(tex.total_texels_);
+    std::memcpy(static_cast<void*>(tex.texels_.data()), img.rgba.data(), count0 * sizeof(glm::vec4));
+    img = Image();  // release the source before the chain needs its scratch rows
+    for (int l = 1; l < tex.level_count_; ++l) {
         const Level& a = tex.levels_[l - 1];
         const Level& b = tex.levels_[l];
-        downsample(tex.texels_.data() + a.offset, a.width, a.height, tex.texels_.data() + b.offset,
-                   b.width, b.height, tmp);
+        glm::vec4* base = tex.texels_.data();
+        for_row_chunks(pool, b.height, std::size_t(b.width), [&](int j0, int j1) {
+            std::vector<glm::vec4> tmp;
+            downsample(base + a.offset, a.width, a.height, base + b.offset, b.width, j0, j1, tmp);
+        });
     }
+    tex.memory_bytes_ = tex.total_texels_ * sizeof(glm::vec4);
     return tex;
+}
+
+Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const float* const tables[4],
+                             const int swizzle[4], int w, int h, Wrap s, Wrap t, ThreadPool* pool) {
+    Texture tex;
+    tex.wrap_s_ = s;
+    tex.wrap_t_ = t;
+    tex.channels_ = channels;
+    bool srgb_channel[4] = {false, false, false, false};
+    for (int c = 0; c < 4; ++c) {
+        tex.table_[c] = tables[c];
+        tex.swizzle_[c] = swizzle[c];
+        srgb_channel[c] = c < channels && tables[c] == srgb8_decode_table();
+    }
+    tex.layout(w, h);
+    const std::size_t C = std::size_t(channels);
+    // 3 spare bytes: the block sampler reads 4 bytes at any texel.
+    const std::size_t bytes = tex.total_texels_ * C + 3;
+    tex.bytes_.reset(allocate_texels(bytes));
+    std::uint8_t* base = tex.bytes_.get();
+    std::memset(base + tex.total_texels_ * C, 0, 3);
+    if (level0) std::memcpy(base, level0, std::size_t(w) * std::size_t(h) * C);
+    for (int l = 1; l < tex.level_count_; ++l) {
+        const Level& a = tex.levels_[l - 1];
+        const Level& b = tex.levels_[l];
+        for_row_chunks(pool, b.height, std::size_t(b.width), [&](int j0, int j1) {
+            downsample_unorm8(base + a.offset * C, a.width, a.height, base + b.offset * C, b.width, j0, j1,
+                              channels, srgb_channel);
+        });
+    }
+    tex.memory_bytes_ = tex.total_texels_ * C;
+    return tex;
+}
+
+Texture Texture::pack_roughness_metal(const Image& rough, const Image& metal, Wrap s, Wrap t, ThreadPool* pool) {
+    if (!rough.is_8bit() || !metal.is_8bit() || rough.srgb || metal.srgb)
+        throw std::invalid_argument("Texture::pack_roughness_metal: needs two 8-bit linear images");
+    if (rough.empty() || rough.width != metal.width || rough.height != metal.height)
+        throw std::invalid_argument("Texture::pack_roughness_metal: the images differ in size");
+    if (rough.pixels.size() != rough.texel_count() * std::size_t(rough.channels) ||
+        metal.pixels.size() != metal.texel_count() * std::size_t(metal.channels))
+        throw std::invalid_argument("Texture::pack_roughness_metal: wrong data size");
+    const float* linear = unorm8_decode_table();
+    const float* tables[4] = {linear, linear, linear, linear};
+    static const int kSwizzle[4] = {0, 0, 1, kOne};
+    const std::size_t n = rough.texel_count();
+    std::unique_ptr<std::uint8_t[], FreeBytes> packed(allocate_texels(n * 2));
+    const std::size_t rc = std::size_t(rough.channels), mc = std::size_t(metal.channels);
+    for (std::size_t i = 0; i < n; ++i) {
+        packed[2 * i] = rough.pixels[i * rc];
+        packed[2 * i + 1] = metal.pixels[i * mc];
+    }
+    return from_unorm8(packed.get(), 2, tables, kSwizzle, rough.width, rough.height, s, t, pool);
 }
 
 glm::vec4 Texture::texel(int level, int x, int y) const {
     const Level& L = levels_[clamp_level(level)];
     x = std::clamp(x, 0, L.width - 1);
     y = std::clamp(y, 0, L.height - 1);
-    return texels_[L.offset + std::size_t(y) * std::size_t(L.width) + std::size_t(x)];
+    return texel_at(L.offset + std::size_t(y) * std::size_t(L.width) + std::size_t(x));
 }
 
 } // namespace prast

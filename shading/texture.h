@@ -5,7 +5,17 @@
 // v = 0 is the TOP row of the image (the project's internal UVs; no flipping
 // here), lambda = log2(max(|d(uv * size)/dx|, |d(uv * size)/dy|)) with level-0
 // sizes, as the OpenGL specification writes it (no anisotropy). Filtering and
-// mip generation happen in linear space: sRGB images are decoded on load.
+// mip generation happen in linear space.
+//
+// Storage follows the image: 8-bit images keep 1 to 4 bytes per texel (a
+// 2048x2048 RGBA map with its mips is 21.3 MB, not the 89 MB of float RGBA),
+// decoded to float per texel when sampled through 256-entry tables (sRGB for
+// the colour channels of colour maps), so level 0 samples exactly the floats a
+// float texture of the decoded image would. Their mips are stored in 8 bits
+// too, as GPUs store generated mips: each texel is the correctly rounded byte
+// of the exact area-weighted box filter of the level above, in linear space
+// (sRGB channels are decoded, filtered, and re-encoded). Float images (HDR,
+// 16-bit, procedural) keep float RGBA texels and float mips.
 //
 // A Texture is immutable after construction and is shared read-only between
 // render threads: no caches, no allocation and no virtual calls when sampling.
@@ -14,6 +24,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -22,6 +34,8 @@
 #include "scene/scene.h"
 
 namespace prast {
+
+class ThreadPool;
 
 class Texture {
 public:
@@ -35,9 +49,21 @@ public:
     // per axis; an odd size n = 2m + 1 gives m texels that each cover n / m
     // source texels, i.e. 3 taps weighted (m - i, m, i + 1) / n for output i.
     // Every source texel gives away exactly its area, so the mean of each level
-    // equals the mean of level 0 (up to float rounding).
-    // Throws std::invalid_argument for an empty image or a wrong rgba size.
-    static Texture from_image(Image img, Wrap s = Wrap::Repeat, Wrap t = Wrap::Repeat);
+    // equals the mean of level 0 (up to rounding). Float images filter in
+    // float; 8-bit ones as the file comment says. The rows of each level are
+    // built in parallel on `pool` when given (same bytes on any thread count).
+    // Throws std::invalid_argument for an empty image or a wrong data size.
+    static Texture from_image(Image img, Wrap s = Wrap::Repeat, Wrap t = Wrap::Repeat,
+                              ThreadPool* pool = nullptr);
+
+    // Separate roughness and metalness maps (OBJ map_Pr, map_Pm: 8-bit linear,
+    // same size; channel R of each is used) packed into one 2-byte texture
+    // that samples as (rough, rough, metal, 1), i.e. as a glTF
+    // metallic-roughness map (G rough, B metal), with bit for bit the values
+    // the two maps give apart. Throws std::invalid_argument when they cannot
+    // be packed (float storage, sRGB, different sizes).
+    static Texture pack_roughness_metal(const Image& rough, const Image& metal, Wrap s = Wrap::Repeat,
+                                        Wrap t = Wrap::Repeat, ThreadPool* pool = nullptr);
 
     int levels() const { return level_count_; }
     int width(int level) const { return levels_[clamp_level(level)].width; }
@@ -45,14 +71,32 @@ public:
     Wrap wrap_s() const { return wrap_s_; }
     Wrap wrap_t() const { return wrap_t_; }
 
-    // One stored texel; the level and coordinates are clamped to the valid range.
+    // One stored texel as linear RGBA; the level and coordinates are clamped to
+    // the valid range.
     glm::vec4 texel(int level, int x, int y) const;
     // The mean colour of the image: the last (1x1) level.
     glm::vec4 average() const { return texel(level_count_ - 1, 0, 0); }
+    // The texel at index i of the whole chain (level_offset(k) + y * width + x),
+    // as linear RGBA: what the samplers filter.
+    glm::vec4 texel_at(std::size_t i) const;
+
+    // Storage. Float: texel_data() holds float RGBA. 8-bit: unorm8_data() holds
+    // channels() bytes per texel (and 3 more bytes, so that 4 bytes can be read
+    // at any texel); stored channel c becomes a float through table(c), and
+    // output component k (r, g, b, a) is stored channel swizzle(k), or 1 when
+    // swizzle(k) == kOne.
+    static constexpr int kOne = 4;
+    bool is_unorm8() const { return channels_ > 0; }
+    int channels() const { return channels_; }
+    int swizzle(int k) const { return swizzle_[k]; }
+    const float* table(int c) const { return table_[c]; }
     // The texels of every level, level 0 first, each row-major; level k starts
-    // at level_offset(k). For the 4x4-block sampler (sample_lanes.h).
+    // at texel level_offset(k). For the 4x4-block sampler (sample_lanes.h).
     const glm::vec4* texel_data() const { return texels_.data(); }
+    const std::uint8_t* unorm8_data() const { return bytes_.get(); }
     std::size_t level_offset(int level) const { return levels_[clamp_level(level)].offset; }
+    // Bytes held by the texels of all levels.
+    std::size_t memory_bytes() const { return memory_bytes_; }
 
     // lambda = log2(rho), rho = max(sqrt((dudx w)^2 + (dvdx h)^2),
     // sqrt((dudy w)^2 + (dvdy h)^2)) with the level-0 size w x h. The result is
@@ -90,7 +134,21 @@ private:
     static const Sampler kTrilinear[3][3];
     static const LevelSampler kBilinear[3][3];
 
-    std::vector<glm::vec4> texels_;  // all levels, level 0 first, row-major
+    // Lays out the chain for a w x h level 0.
+    void layout(int w, int h);
+    static Texture from_unorm8(const std::uint8_t* level0, int channels, const float* const tables[4],
+                               const int swizzle[4], int w, int h, Wrap s, Wrap t, ThreadPool* pool);
+
+    struct FreeBytes {
+        void operator()(std::uint8_t* p) const { std::free(p); }
+    };
+    std::vector<glm::vec4> texels_;  // float storage: all levels, level 0 first, row-major
+    std::unique_ptr<std::uint8_t[], FreeBytes> bytes_;  // 8-bit storage, same order
+    int channels_ = 0;               // 0: float storage
+    int swizzle_[4] = {0, 1, 2, 3};
+    const float* table_[4] = {nullptr, nullptr, nullptr, nullptr};
+    std::size_t total_texels_ = 0;
+    std::size_t memory_bytes_ = 0;
     Level levels_[kMaxLevels];
     int level_count_ = 0;
     Wrap wrap_s_ = Wrap::Repeat, wrap_t_ = Wrap::Repeat;
@@ -145,13 +203,14 @@ inline glm::vec4 Texture::bilinear_reduced(float u, float v, int level) const {
     const int xb = texture_detail::wrap_index<S>(x0 + 1, L.width);
     const int ya = texture_detail::wrap_index<T>(y0, L.height);
     const int yb = texture_detail::wrap_index<T>(y0 + 1, L.height);
-    const glm::vec4* base = texels_.data() + L.offset;
-    const glm::vec4* row_a = base + std::size_t(ya) * std::size_t(L.width);
-    const glm::vec4* row_b = base + std::size_t(yb) * std::size_t(L.width);
+    const std::size_t row_a = L.offset + std::size_t(ya) * std::size_t(L.width);
+    const std::size_t row_b = L.offset + std::size_t(yb) * std::size_t(L.width);
+    const glm::vec4 a = texel_at(row_a + std::size_t(xa)), b = texel_at(row_a + std::size_t(xb));
+    const glm::vec4 c = texel_at(row_b + std::size_t(xa)), d = texel_at(row_b + std::size_t(xb));
     // a + (b - a) t: exact at t = 0 and wherever a == b (a constant texture
     // samples to exactly its value).
-    const glm::vec4 top = row_a[xa] + (row_a[xb] - row_a[xa]) * tx;
-    const glm::vec4 bottom = row_b[xa] + (row_b[xb] - row_b[xa]) * tx;
+    const glm::vec4 top = a + (b - a) * tx;
+    const glm::vec4 bottom = c + (d - c) * tx;
     return top + (bottom - top) * ty;
 }
 
@@ -173,6 +232,14 @@ inline glm::vec4 Texture::trilinear_wrapped(float u, float v, float lambda) cons
     const glm::vec4 a = bilinear_reduced<S, T>(ur, vr, l0);
     if (t == 0.0f) return a;
     return a + (bilinear_reduced<S, T>(ur, vr, l0 + 1) - a) * t;
+}
+
+inline glm::vec4 Texture::texel_at(std::size_t i) const {
+    if (channels_ == 0) return texels_[i];
+    const std::uint8_t* p = bytes_.get() + i * std::size_t(channels_);
+    float c[5] = {0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
+    for (int k = 0; k < channels_; ++k) c[k] = table_[k][p[k]];
+    return {c[swizzle_[0]], c[swizzle_[1]], c[swizzle_[2]], c[swizzle_[3]]};
 }
 
 inline glm::vec4 Texture::sample_bilinear(float u, float v, int level) const {

@@ -19,9 +19,9 @@
 
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
-#include <stb_image.h>
 #include <stb_image_write.h>
 
+#include "scene/image_diff.h"
 #include "tests/raster_test_util.h"
 
 using namespace prast;
@@ -1625,25 +1625,21 @@ TEST_CASE("golden image: small sphere/ground/triangles scene is byte-identical t
         FAIL("golden image did not exist: created " << golden.string()
                                                    << " -- review it by eye and commit it, then re-run");
     }
-    int gw = 0, gh = 0, gc = 0;
-    unsigned char* data = stbi_load(golden.string().c_str(), &gw, &gh, &gc, 3);
-    REQUIRE_MESSAGE(data != nullptr, "cannot read " << golden.string());
-    std::vector<std::uint8_t> ref(data, data + std::size_t(gw) * gh * 3);
-    stbi_image_free(data);
-    REQUIRE(gw == W);
-    REQUIRE(gh == H);
-    int differing = 0, max_diff = 0;
-    for (std::size_t i = 0; i < ref.size(); ++i)
-        if (ref[i] != img[i]) {
-            ++differing;
-            max_diff = std::max(max_diff, std::abs(int(ref[i]) - int(img[i])));
-        }
-    if (differing) {
-        const fs::path actual = fs::temp_directory_path() / "raster_scene_actual.png";
-        stbi_write_png(actual.string().c_str(), W, H, 3, img.data(), W * 3);
-        MESSAGE(differing << " bytes differ (max " << max_diff << "); actual image written to " << actual.string());
+    const Image8 expected = read_image8(golden.string());
+    REQUIRE(expected.width == W);
+    REQUIRE(expected.height == H);
+    const Image8 actual = Image8::from_rgb(W, H, img.data());
+    const DiffResult diff = diff_images(actual, expected, {0, 0.0});  // exact
+    if (!diff.match) {
+        const fs::path out = fs::temp_directory_path() / "raster_scene_actual.png";
+        const fs::path heat = fs::temp_directory_path() / "raster_scene_heatmap.png";
+        stbi_write_png(out.string().c_str(), W, H, 3, img.data(), W * 3);
+        const std::vector<std::uint8_t> heat_rgba = diff_heatmap(actual, expected, {0, 0.0});
+        stbi_write_png(heat.string().c_str(), W, H, 4, heat_rgba.data(), W * 4);
+        MESSAGE(format_diff(diff, {0, 0.0}) << "actual image written to " << out.string() << ", heat map to "
+                                            << heat.string());
     }
-    CHECK(differing == 0);
+    CHECK(diff.match);
 }
 
 // ===========================================================================

@@ -25,7 +25,24 @@ using prast::test::bits;
 
 namespace {
 
+// A texture of random content in one of the storages: float RGBA, 8-bit with
+// 1 to 4 channels (sRGB-encoded colour or linear), or a packed roughness +
+// metal pair (two bytes per texel, swizzled).
 Texture random_texture(std::mt19937& rng, int w, int h, Wrap s, Wrap t) {
+    std::uniform_int_distribution<int> kind(0, 9), byte(0, 255);
+    const int k = kind(rng);
+    auto random_bytes = [&](int channels, bool srgb) {
+        Image img;
+        img.width = w;
+        img.height = h;
+        img.channels = channels;
+        img.srgb = srgb;
+        img.pixels.resize(img.texel_count() * std::size_t(channels));
+        for (std::uint8_t& c : img.pixels) c = std::uint8_t(byte(rng));
+        return img;
+    };
+    if (k == 9) return Texture::pack_roughness_metal(random_bytes(1, false), random_bytes(1, false), s, t);
+    if (k >= 1) return Texture::from_image(random_bytes(1 + (k - 1) % 4, k >= 5), s, t);
     std::uniform_real_distribution<float> uni(0.0f, 1.0f);
     Image img;
     img.width = w;

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include <stb_image.h>
 
 #include "scene/default_scene.h"
+#include "scene/image_diff.h"
 #include "scene/write_image.h"
 #include "scene/load_scene.h"
 #include "shading/scene_renderer.h"
@@ -62,22 +62,15 @@ TEST_CASE("built-in scene matches its golden image") {
         write_png_atomic(golden, W, H, px.data());
         FAIL("golden image created at " << golden << ": review it and commit it");
     }
-    int gw = 0, gh = 0, gc = 0;
-    unsigned char* g = stbi_load(golden.c_str(), &gw, &gh, &gc, 4);
-    REQUIRE(g != nullptr);
-    REQUIRE(gw == W);
-    REQUIRE(gh == H);
-    int worst = 0, differing = 0;
-    for (int i = 0; i < W * H; ++i) {
-        int d_px = 0;
-        for (int c = 0; c < 3; ++c) d_px = std::max(d_px, std::abs(int(px[i * 4 + c]) - int(g[i * 4 + c])));
-        worst = std::max(worst, d_px);
-        differing += d_px > 0;
-    }
-    stbi_image_free(g);
-    MESSAGE("golden: max channel difference " << worst << ", differing pixels " << differing);
-    CHECK(worst <= 1);
-    CHECK(differing <= W * H / 1000);
+    // Pixels beyond 0 (tolerance 0) are counted; the largest difference must stay <= 1.
+    const Image8 actual = Image8::from_rgba(W, H, px.data(), false);
+    const Image8 expected = read_image8(golden);
+    REQUIRE(expected.width == W);
+    REQUIRE(expected.height == H);
+    const DiffResult diff = diff_images(actual, expected, {0, 0.001});
+    MESSAGE("golden: max channel difference " << diff.max_diff << ", differing pixels " << diff.differing);
+    CHECK(diff.max_diff <= 1);
+    CHECK(diff.match);  // at most floor(0.001 * W * H) pixels differ at all
 }
 
 TEST_CASE("PBR frames are byte-identical for any thread count and tile size") {

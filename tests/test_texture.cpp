@@ -347,17 +347,23 @@ TEST_CASE("decode: sRGB 8-bit RGBA, grey, grey+alpha") {
     const Image linear = decode_image(file_source(path), false);
     REQUIRE(srgb.width == 4);
     REQUIRE(srgb.height == 1);
+    // Kept as the file's bytes: 4 channels, marked sRGB or not.
+    CHECK(srgb.channels == 4);
+    CHECK(srgb.srgb);
+    CHECK(!linear.srgb);
+    CHECK(srgb.pixels == std::vector<std::uint8_t>(rgba, rgba + 16));
+    CHECK(srgb.rgba.empty());
     for (int i = 0; i < 16; ++i) {
         const float c = rgba[i] / 255.0f;
         const bool alpha = i % 4 == 3;
-        CHECK(srgb.rgba[i] == doctest::Approx(alpha ? c : srgb_reference(c)).epsilon(1e-6));
-        CHECK(linear.rgba[i] == doctest::Approx(c).epsilon(1e-7));
+        CHECK(srgb.at(i / 4, 0)[i % 4] == doctest::Approx(alpha ? c : srgb_reference(c)).epsilon(1e-6));
+        CHECK(linear.at(i / 4, 0)[i % 4] == doctest::Approx(c).epsilon(1e-7));
     }
     // Known values: sRGB 128 -> 0.21586, 188 -> 0.50289.
-    CHECK(srgb.rgba[2] == doctest::Approx(0.2158605).epsilon(1e-5));
-    CHECK(srgb.rgba[5] == doctest::Approx(0.5028865).epsilon(1e-5));
-    CHECK(srgb.rgba[0] == 0.0f);
-    CHECK(srgb.rgba[4] == 1.0f);
+    CHECK(srgb.at(0, 0).b == doctest::Approx(0.2158605).epsilon(1e-5));
+    CHECK(srgb.at(1, 0).g == doctest::Approx(0.5028865).epsilon(1e-5));
+    CHECK(srgb.at(0, 0).r == 0.0f);
+    CHECK(srgb.at(1, 0).r == 1.0f);
 
     // 3x2 grey: replicated to RGB, alpha 1.
     const unsigned char grey[6] = {0, 51, 102, 153, 204, 255};
@@ -366,6 +372,7 @@ TEST_CASE("decode: sRGB 8-bit RGBA, grey, grey+alpha") {
     const Image g = decode_image(file_source(grey_path), false);
     REQUIRE(g.width == 3);
     REQUIRE(g.height == 2);
+    CHECK(g.channels == 1);
     for (int i = 0; i < 6; ++i) {
         const glm::vec4 t = g.at(i % 3, i / 3);
         CHECK(t.r == doctest::Approx(grey[i] / 255.0f));
@@ -381,6 +388,7 @@ TEST_CASE("decode: sRGB 8-bit RGBA, grey, grey+alpha") {
     const std::string ga_path = dir.file("ga.png");
     REQUIRE(stbi_write_png(ga_path.c_str(), 2, 1, 2, ga, 4));
     const Image gai = decode_image(file_source(ga_path), true);
+    CHECK(gai.channels == 2);
     CHECK(gai.at(0, 0).b == doctest::Approx(srgb_reference(128 / 255.0f)).epsilon(1e-6));
     CHECK(gai.at(0, 0).a == doctest::Approx(64 / 255.0f));
 
@@ -388,7 +396,7 @@ TEST_CASE("decode: sRGB 8-bit RGBA, grey, grey+alpha") {
     ImageSource embedded;
     embedded.bytes = read_bytes(path);
     embedded.name = "scene.glb#image0";
-    CHECK(decode_image(embedded, true).rgba == srgb.rgba);
+    CHECK(decode_image(embedded, true).pixels == srgb.pixels);
     const unsigned char two_rows[2] = {0, 255};
     const std::string rows_path = dir.file("rows.png");
     REQUIRE(stbi_write_png(rows_path.c_str(), 1, 2, 1, two_rows, 1));
@@ -530,7 +538,7 @@ TEST_CASE("decode: randomly corrupted PNG and JPEG never crash") {
             src.name = "fuzz" + std::to_string(round);
             try {
                 const Image img = decode_image(src, round % 2 == 0);
-                CHECK(img.rgba.size() == std::size_t(img.width) * std::size_t(img.height) * 4);
+                CHECK(img.pixels.size() == img.texel_count() * std::size_t(img.channels));
                 ++decoded;
             } catch (const LoadError& e) {
                 CHECK(std::string(e.what()).find(src.name) != std::string::npos);

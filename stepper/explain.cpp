@@ -1,0 +1,629 @@
+// Text and JSON explanations of the recorded frame; see explain.h.
+#include "stepper/explain.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+#include <unordered_map>
+
+#include "shading/color.h"
+#include "shading/tonemap.h"
+#include "stepper/format.h"
+#include "stepper/frame_loop.h"
+
+namespace prast::stepper {
+
+using nlohmann::json;
+
+const char* fate_name(TriangleFate f) {
+    switch (f) {
+    case TriangleFate::Invalid: return "invalid (non-finite position or index out of range)";
+    case TriangleFate::CulledFrustum: return "culled (outside the frustum)";
+    case TriangleFate::CulledBack: return "culled (back face)";
+    case TriangleFate::Degenerate: return "degenerate (zero area or no pixel centre)";
+    case TriangleFate::SetUp: return "set up";
+    }
+    return "?";
+}
+
+std::string mesh_name(const StepScene& s, const Recording& rec, std::uint32_t tri) {
+    return s.scene.meshes[std::size_t(rec.draw_of(tri).mesh)].name;
+}
+
+namespace {
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+json j3(const glm::vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+std::string plane_names(std::uint32_t planes) {
+    static const struct { std::uint32_t bit; const char* name; } kNames[] = {
+        {kOutLeft, "left"}, {kOutRight, "right"}, {kOutBottom, "bottom"}, {kOutTop, "top"},
+        {kOutNear, "near"}, {kOutFar, "far"}, {kOutGuardLeft, "guard-left"},
+        {kOutGuardRight, "guard-right"}, {kOutGuardBottom, "guard-bottom"}, {kOutGuardTop, "guard-top"}};
+    std::string out;
+    for (const auto& n : kNames)
+        if (planes & n.bit) out += (out.empty() ? "" : ",") + std::string(n.name);
+    return out.empty() ? "inside" : out;
+}
+
+// ---- Texture footprints: which texels a trilinear sample blended.
+
+float reduce_wrap(Wrap w, float c) {
+    switch (w) {
+    case Wrap::Repeat: return texture_detail::reduce<Wrap::Repeat>(c);
+    case Wrap::MirroredRepeat: return texture_detail::reduce<Wrap::MirroredRepeat>(c);
+    case Wrap::ClampToEdge: break;
+    }
+    return texture_detail::reduce<Wrap::ClampToEdge>(c);
+}
+
+int wrap_texel(Wrap w, int i, int n) {
+    switch (w) {
+    case Wrap::Repeat: return texture_detail::wrap_index<Wrap::Repeat>(i, n);
+    case Wrap::MirroredRepeat: return texture_detail::wrap_index<Wrap::MirroredRepeat>(i, n);
+    case Wrap::ClampToEdge: break;
+    }
+    return texture_detail::wrap_index<Wrap::ClampToEdge>(i, n);
+}
+
+const char* wrap_name(Wrap w) {
+    return w == Wrap::Repeat ? "repeat" : w == Wrap::MirroredRepeat ? "mirror" : "clamp";
+}
+
+std::string level_footprint(const Texture& tex, glm::vec2 uv, int level) {
+    const int w = tex.width(level), h = tex.height(level);
+    const float x = reduce_wrap(tex.wrap_s(), uv.x) * float(w) - 0.5f;
+    const float y = reduce_wrap(tex.wrap_t(), uv.y) * float(h) - 0.5f;
+    const float fx = std::floor(x), fy = std::floor(y);
+    const int x0 = int(fx), y0 = int(fy);
+    const int xa = wrap_texel(tex.wrap_s(), x0, w), xb = wrap_texel(tex.wrap_s(), x0 + 1, w);
+    const int ya = wrap_texel(tex.wrap_t(), y0, h), yb = wrap_texel(tex.wrap_t(), y0 + 1, h);
+    std::string s = "level " + std::to_string(level) + " (" + std::to_string(w) + "x" + std::to_string(h) +
+                    "): texels x " + std::to_string(xa) + "," + std::to_string(xb) + " y " + std::to_string(ya) +
+                    "," + std::to_string(yb) + " weights " + num(x - fx) + ", " + num(y - fy) + ": " +
+                    vec(tex.texel(level, xa, ya)) + " " + vec(tex.texel(level, xb, ya)) + " " +
+                    vec(tex.texel(level, xa, yb)) + " " + vec(tex.texel(level, xb, yb));
+    return s;
+}
+
+// One map: its size, the level of detail, the levels and texels blended, the value.
+std::string map_text(const char* name, const Texture* tex, glm::vec2 uv, float lambda, const char* indent) {
+    if (!tex) return "";
+    std::string s = std::string(indent) + "map " + name + ": " + std::to_string(tex->width(0)) + "x" +
+                    std::to_string(tex->height(0)) + ", " + std::to_string(tex->levels()) + " levels, wrap " +
+                    wrap_name(tex->wrap_s()) + "/" + wrap_name(tex->wrap_t()) + ", lambda " + num(lambda);
+    const int last = tex->levels() - 1;
+    std::vector<int> levels;
+    if (!(lambda > 0.0f)) {
+        s += " (magnification: bilinear on level 0)";
+        levels = {0};
+    } else if (lambda >= float(last)) {
+        s += " (past the last level: bilinear on level " + std::to_string(last) + ")";
+        levels = {last};
+    } else {
+        const float fl = std::floor(lambda);
+        const float t = lambda - fl;
+        s += " (trilinear: levels " + std::to_string(int(fl)) + " and " + std::to_string(int(fl) + 1) +
+             ", blend " + num(t) + ")";
+        levels = {int(fl)};
+        if (t != 0.0f) levels.push_back(int(fl) + 1);
+    }
+    s += "\n";
+    for (int L : levels) s += std::string(indent) + "  " + level_footprint(*tex, uv, L) + "\n";
+    s += std::string(indent) + "  sample " + vec(tex->sample_trilinear(uv.x, uv.y, lambda)) + "\n";
+    return s;
+}
+
+const char* conductor_name(Conductor c) {
+    switch (c) {
+    case Conductor::Gold: return "gold";
+    case Conductor::Copper: return "copper";
+    case Conductor::Aluminium: return "aluminium";
+    case Conductor::Silver: return "silver";
+    case Conductor::None: break;
+    }
+    return "none";
+}
+
+glm::vec3 color_of(const Framebuffer& fb, int x, int y) {
+    const float* c = fb.pixel(x, y);
+    return glm::vec3(c[0], c[1], c[2]);
+}
+
+} // namespace
+
+// ---------------------------------------------------------------- tile walk
+
+TileWalk walk_tile(const Recording& rec, std::uint32_t piece, int tile) {
+    TileWalk w;
+    w.tile = tile;
+    const PieceRecord& p = rec.pieces[piece];
+    if (p.setup == kNone) return w;
+    const TriangleSetup& t = rec.setups[p.setup];
+    const int ts = rec.tile_size;
+    const int tx0 = (tile % rec.tiles_x) * ts, ty0 = (tile / rec.tiles_x) * ts;
+    const int tx1 = std::min(tx0 + ts, rec.width) - 1, ty1 = std::min(ty0 + ts, rec.height) - 1;
+    const int x0 = std::max(tx0, t.minx), x1 = std::min(tx1, t.maxx);
+    const int y0 = std::max(ty0, t.miny), y1 = std::min(ty1, t.maxy);
+    auto count_coverage = [&](int bx, int by, unsigned partial) {
+        std::uint32_t mask = 0;
+        for (int l = 0; l < kBlockLanes; ++l) {
+            const int x = bx + lane_x(l), y = by + lane_y(l);
+            if (x >= rec.width || y >= rec.height) continue;
+            bool in = true;
+            for (int e = 0; e < 3; ++e)
+                if ((partial & (1u << e)) && edge_at_pixel(t, e, x, y) < 0) in = false;
+            if (in) mask |= 1u << l;
+        }
+        if (mask) ++w.fine_with_coverage;
+    };
+    if (x0 <= x1 && y0 <= y1) {
+        // rasterize_triangle(): 16x16 blocks, then 4x4 blocks of the partial ones.
+        for (int cy = y0 & ~(kCoarseBlockSize - 1); cy <= y1; cy += kCoarseBlockSize)
+            for (int cx = x0 & ~(kCoarseBlockSize - 1); cx <= x1; cx += kCoarseBlockSize) {
+                unsigned partial = 0;
+                bool out = false;
+                for (int e = 0; e < 3 && !out; ++e) {
+                    const EdgeClass c = classify_block(t, e, cx, cy, kCoarseBlockSize);
+                    if (c == kEdgeOut) out = true;
+                    else if (c == kEdgePartial) partial |= 1u << e;
+                }
+                if (out) { ++w.coarse_rejected; continue; }
+                if (partial == 0) ++w.coarse_accepted;
+                else ++w.coarse_partial;
+                const int bx_lo = std::max(cx, x0 & ~(kBlockSize - 1)), bx_hi = std::min(cx + kCoarseBlockSize - 1, x1);
+                const int by_lo = std::max(cy, y0 & ~(kBlockSize - 1)), by_hi = std::min(cy + kCoarseBlockSize - 1, y1);
+                for (int by = by_lo; by <= by_hi; by += kBlockSize)
+                    for (int bx = bx_lo; bx <= bx_hi; bx += kBlockSize) {
+                        if (partial == 0) {
+                            ++w.fine_accepted;
+                            count_coverage(bx, by, 0);
+                            continue;
+                        }
+                        unsigned block_partial = 0;
+                        bool block_out = false;
+                        for (int e = 0; e < 3 && !block_out; ++e) {
+                            if (!(partial & (1u << e))) continue;
+                            const EdgeClass c = classify_block(t, e, bx, by, kBlockSize);
+                            if (c == kEdgeOut) block_out = true;
+                            else if (c == kEdgePartial) block_partial |= 1u << e;
+                        }
+                        if (block_out) { ++w.fine_rejected; continue; }
+                        if (block_partial) ++w.fine_walked;
+                        else ++w.fine_accepted;
+                        count_coverage(bx, by, block_partial);
+                    }
+            }
+    }
+    for (const BlockRecord& b : rec.tiles[std::size_t(tile)].blocks) {
+        if (b.piece != piece) continue;
+        ++w.recorded_blocks;
+        w.covered += __builtin_popcount(b.mask);
+        w.passed += __builtin_popcount(b.pass);
+        w.written += __builtin_popcount(b.live);
+    }
+    return w;
+}
+
+// ---------------------------------------------------------------- frame
+
+std::string frame_text(const StepScene& s, const Recording& rec) {
+    std::ostringstream o;
+    const Camera& c = s.settings.camera;
+    o << "frame " << rec.width << "x" << rec.height << ", tiles of " << rec.tile_size << " (" << rec.tiles_x << "x"
+      << rec.tiles_y << ")\n";
+    o << "scene " << (s.options.scene.empty() ? "built-in" : s.options.scene) << ": " << rec.triangle_count()
+      << " triangles, " << s.scene.meshes.size() << " meshes, " << s.scene.materials.size() << " materials\n";
+    o << "camera eye " << vec(c.eye) << " target " << vec(c.target) << " up " << vec(c.up) << " fov "
+      << num(c.fov_y_deg) << " near " << num(c.near_plane) << " far " << num(c.far_plane) << "\n";
+    for (std::size_t i = 0; i < s.settings.lights.size(); ++i) {
+        const ShadingLight& L = s.settings.lights[i];
+        o << "light " << i << ": " << (L.point ? "point at " + vec(L.position) : "sun towards " + vec(L.direction))
+          << " radiance " << vec(L.radiance) << "\n";
+    }
+    o << "ambient " << vec(s.settings.ambient) << ", brdf " << brdf_model_name(s.settings.model) << ", exposure "
+      << num(s.exposure()) << ", tone map " << tonemap_name(s.tonemap()) << "\n";
+    // The counters, without the times (those are for `cost`).
+    std::istringstream stats(rec.stats.to_string());
+    for (std::string l; std::getline(stats, l);)
+        if (l.compare(0, 4, "time") != 0) o << l << "\n";
+    std::size_t blocks = 0, depths = 0, bins = 0;
+    for (const TileRecord& t : rec.tiles) {
+        blocks += t.blocks.size();
+        depths += t.z.size();
+        bins += t.pieces.size();
+    }
+    o << "recording " << rec.bytes() << " bytes: " << rec.draws.size() << " draws, " << rec.triangles.size()
+      << " triangles, " << rec.pieces.size() << " pieces, " << rec.setups.size() << " setups, " << bins
+      << " bin entries, " << blocks << " blocks, " << depths << " depths\n";
+    return o.str();
+}
+
+json frame_json(const StepScene& s, const Recording& rec) {
+    json j;
+    j["width"] = rec.width;
+    j["height"] = rec.height;
+    j["tile_size"] = rec.tile_size;
+    j["tiles_x"] = rec.tiles_x;
+    j["tiles_y"] = rec.tiles_y;
+    j["triangles"] = rec.triangle_count();
+    j["draws"] = rec.draws.size();
+    j["recording_bytes"] = rec.bytes();
+    j["text"] = frame_text(s, rec);
+    return j;
+}
+
+// ---------------------------------------------------------------- triangle
+
+std::string triangle_text(const StepScene& s, const Recording& rec, std::uint32_t tri) {
+    std::ostringstream o;
+    const DrawRecord& d = rec.draw_of(tri);
+    const TriangleRecord& tr = rec.triangles[tri];
+    const BoundMaterial& bm = material_of(s, rec, tri);
+    o << "tri " << tri << ": draw " << (&d - rec.draws.data()) << " mesh " << d.mesh << " "
+      << quoted(mesh_name(s, rec, tri)) << " prim " << (tri - d.first_triangle) << " of " << d.triangle_count
+      << ", material " << quoted(bm.m->name) << ", cull " << (d.state.cull == CullMode::Back ? "back" : "none")
+      << "\n";
+    if (!tr.seen) {
+        o << "  not submitted\n";
+        return o.str();
+    }
+    const ClipReplay c = replay_clip(s, rec, tri);
+    o << "  vertices " << c.index[0] << " " << c.index[1] << " " << c.index[2] << "\n";
+    if (!c.valid) {
+        o << "  fate: " << fate_name(tr.fate) << "\n";
+        return o.str();
+    }
+    for (int i = 0; i < 3; ++i) {
+        const float* v = &d.vertices[std::size_t(c.index[i]) * kStride];
+        o << "  clip v" << i << " " << vec(glm::vec4(v[0], v[1], v[2], v[3])) << " outside: " << plane_names(c.outcode[i])
+          << "\n";
+    }
+    if (tr.clipped) {
+        o << "  clipping: against " << plane_names(c.planes) << " -> polygon of " << c.count << " vertices, "
+          << std::max(0, c.count - 2) << " pieces (a fan from vertex 0)\n";
+        for (int i = 0; i < c.count; ++i)
+            o << "    p" << i << " " << vec(glm::vec4(c.polygon[i][0], c.polygon[i][1], c.polygon[i][2], c.polygon[i][3]))
+              << "\n";
+    } else {
+        o << "  clipping: none needed" << ((c.outcode[0] & c.outcode[1] & c.outcode[2] & kFrustumBits)
+                                               ? " (all three vertices outside one frustum plane)" : "")
+          << "\n";
+    }
+    o << "  fate: " << fate_name(tr.fate) << "\n";
+    for (std::uint32_t k = 0; k < tr.piece_count; ++k) {
+        const std::uint32_t pi = tr.first_piece + k;
+        const PieceRecord& p = rec.pieces[pi];
+        o << "  piece " << k << ": " << fate_name(p.fate);
+        if (p.setup == kNone) {
+            o << "\n";
+            continue;
+        }
+        const TriangleSetup& t = rec.setups[p.setup];
+        o << ", " << (t.front_facing ? "front" : "back") << " face\n";
+        float v[3][kStride];
+        piece_vertices(s, rec, pi, v);
+        SnappedVertex sv[3];
+        o << "    window vertices (setup order, snapped to 1/256 px):\n";
+        for (int i = 0; i < 3; ++i) {
+            sv[i] = snap_vertex(v[i], rec.width, rec.height);
+            o << "      v" << i << " (" << num(sv[i].x_win) << ", " << num(sv[i].y_win) << ") -> fixed (" << sv[i].fx
+              << ", " << sv[i].fy << ") = (" << num(double(sv[i].fx) / 256.0) << ", " << num(double(sv[i].fy) / 256.0)
+              << ") px, z " << num(t.z[i]) << ", 1/w " << num(t.inv_w[i]) << "\n";
+        }
+        o << "    edges E(x, y) = A x + B y + C at pixel centres (1/256 px), inside when E >= 0:\n";
+        bool consistent = true;
+        for (int e = 0; e < 3; ++e) {
+            const int a = (e + 1) % 3, b = (e + 2) % 3;
+            const bool top = t.A[e] == 0 && t.B[e] > 0, left = t.A[e] > 0;
+            consistent &= std::int64_t(t.A[e]) == sv[a].fy - sv[b].fy && std::int64_t(t.B[e]) == sv[b].fx - sv[a].fx;
+            o << "      e" << e << " (v" << a << " -> v" << b << "): A " << t.A[e] << " B " << t.B[e] << " C " << t.C[e]
+              << (top ? "  top edge: no bias" : left ? "  left edge: no bias"
+                                                     : "  neither top nor left: C includes the -1 bias")
+              << "\n";
+        }
+        if (!consistent) o << "    NOTE: the snapped vertices above do not reproduce A and B\n";
+        const std::int64_t area2 = (sv[1].fx - sv[0].fx) * (sv[2].fy - sv[0].fy) - (sv[2].fx - sv[0].fx) * (sv[1].fy - sv[0].fy);
+        o << "    area " << num(double(area2 < 0 ? -area2 : area2) / (2.0 * 65536.0)) << " px (2 x area = " << area2
+          << " in 1/65536 px^2)\n";
+        o << "    box x " << t.minx << ".." << t.maxx << " y " << t.miny << ".." << t.maxy << "\n";
+        o << "    barycentric planes at the box corner: b0 " << num(t.bary[0][0]) << " + " << num(t.bary[0][1])
+          << " dx + " << num(t.bary[0][2]) << " dy; b1 " << num(t.bary[1][0]) << " + " << num(t.bary[1][1]) << " dx + "
+          << num(t.bary[1][2]) << " dy; b2 " << num(t.bary[2][0]) << " + " << num(t.bary[2][1]) << " dx + "
+          << num(t.bary[2][2]) << " dy\n";
+        o << "    binned to " << p.tile_count << " tile" << (p.tile_count == 1 ? "" : "s") << ":\n";
+        for (std::uint32_t i = 0; i < p.tile_count; ++i) {
+            const int tile = int(rec.piece_tiles[p.first_tile + i]);
+            const TileWalk w = walk_tile(rec, pi, tile);
+            o << "      tile " << tile % rec.tiles_x << " " << tile / rec.tiles_x << ": 16x16 blocks "
+              << w.coarse_rejected << " rejected, " << w.coarse_accepted << " accepted, " << w.coarse_partial
+              << " partial; 4x4 blocks " << w.fine_rejected << " rejected, " << w.fine_accepted << " accepted, "
+              << w.fine_walked << " walked; " << w.recorded_blocks << " blocks with coverage, " << w.covered
+              << " fragments, " << w.passed << " passed depth, " << w.written << " written\n";
+            if (w.fine_with_coverage != w.recorded_blocks)
+                o << "      NOTE: the walk finds " << w.fine_with_coverage << " covered blocks, the recording "
+                  << w.recorded_blocks << "\n";
+        }
+    }
+    return o.str();
+}
+
+json triangle_json(const StepScene& s, const Recording& rec, std::uint32_t tri) {
+    json j;
+    const TriangleRecord& tr = rec.triangles[tri];
+    j["tri"] = tri;
+    j["fate"] = fate_name(tr.fate);
+    j["clipped"] = tr.clipped;
+    json pieces = json::array();
+    for (std::uint32_t k = 0; k < tr.piece_count; ++k) {
+        const PieceRecord& p = rec.pieces[tr.first_piece + k];
+        json pj;
+        pj["fate"] = fate_name(p.fate);
+        if (p.setup != kNone) {
+            float v[3][kStride];
+            piece_vertices(s, rec, tr.first_piece + k, v);
+            json verts = json::array();
+            for (int i = 0; i < 3; ++i) {
+                const SnappedVertex sv = snap_vertex(v[i], rec.width, rec.height);
+                verts.push_back(json::array({double(sv.fx) / 256.0, double(sv.fy) / 256.0}));
+            }
+            pj["window"] = verts;
+            const TriangleSetup& t = rec.setups[p.setup];
+            pj["box"] = json::array({t.minx, t.miny, t.maxx, t.maxy});
+            json tiles = json::array();
+            for (std::uint32_t i = 0; i < p.tile_count; ++i) tiles.push_back(rec.piece_tiles[p.first_tile + i]);
+            pj["tiles"] = tiles;
+        }
+        pieces.push_back(pj);
+    }
+    j["pieces"] = pieces;
+    j["text"] = triangle_text(s, rec, tri);
+    return j;
+}
+
+// ---------------------------------------------------------------- tile
+
+std::string tile_text(const StepScene& s, const Recording& rec, int tx, int ty) {
+    std::ostringstream o;
+    const int tile = ty * rec.tiles_x + tx;
+    const TileRecord& t = rec.tiles[std::size_t(tile)];
+    const int x0 = tx * rec.tile_size, y0 = ty * rec.tile_size;
+    o << "tile " << tx << " " << ty << ": pixels x " << x0 << ".." << std::min(x0 + rec.tile_size, rec.width) - 1
+      << " y " << y0 << ".." << std::min(y0 + rec.tile_size, rec.height) - 1 << ", " << t.pieces.size()
+      << " bin entries, " << t.blocks.size() << " blocks, in the order the tile ran them:\n";
+    // Blocks of each piece, in one pass over the tile's blocks.
+    struct Counts { int blocks = 0, covered = 0, passed = 0, written = 0; };
+    std::unordered_map<std::uint32_t, Counts> counts;
+    for (const BlockRecord& b : t.blocks) {
+        Counts& c = counts[b.piece];
+        ++c.blocks;
+        c.covered += __builtin_popcount(b.mask);
+        c.passed += __builtin_popcount(b.pass);
+        c.written += __builtin_popcount(b.live);
+    }
+    for (std::uint32_t pi : t.pieces) {
+        const PieceRecord& p = rec.pieces[pi];
+        const TriangleRecord& tr = rec.triangles[p.triangle];
+        const auto it = counts.find(pi);
+        const Counts c = it == counts.end() ? Counts{} : it->second;
+        const int blocks = c.blocks, covered = c.covered, passed = c.passed, written = c.written;
+        o << "  tri " << p.triangle;
+        if (tr.piece_count > 1) o << " piece " << (pi - tr.first_piece);
+        o << " (" << quoted(mesh_name(s, rec, p.triangle)) << "): " << blocks << " blocks, " << covered
+          << " fragments, " << passed << " passed depth, " << written << " written\n";
+    }
+    return o.str();
+}
+
+json tile_json(const StepScene& s, const Recording& rec, int tx, int ty) {
+    json j;
+    const int tile = ty * rec.tiles_x + tx;
+    j["tile"] = json::array({tx, ty});
+    json tris = json::array();
+    for (std::uint32_t pi : rec.tiles[std::size_t(tile)].pieces) tris.push_back(rec.pieces[pi].triangle);
+    j["triangles"] = tris;
+    j["text"] = tile_text(s, rec, tx, ty);
+    return j;
+}
+
+// ---------------------------------------------------------------- pixel
+
+PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, int y) {
+    PixelExplanation px;
+    px.x = x;
+    px.y = y;
+    const ShadingContext ctx = shading_context(s.settings);
+    const TileRecord& tile = rec.tiles[std::size_t(rec.tile_of(x, y))];
+    const int bx = x & ~(kBlockSize - 1), by = y & ~(kBlockSize - 1);
+    int lane = 0;
+    for (int l = 0; l < kBlockLanes; ++l)
+        if (lane_x(l) == x - bx && lane_y(l) == y - by) lane = l;
+    float depth = 1.0f;                 // cleared
+    glm::vec3 color(0.0f);              // cleared to black
+    for (const BlockRecord& b : tile.blocks) {
+        if (b.bx != bx || b.by != by || !(b.mask & (1u << lane))) continue;
+        HistoryEntry h;
+        h.piece = b.piece;
+        h.lane = lane;
+        h.block = &b;
+        h.z = tile.z[b.z + std::size_t(__builtin_popcount(b.mask & ((1u << lane) - 1u)))];
+        h.depth_before = depth;
+        h.color_before = color;
+        h.passed = (b.pass >> lane) & 1u;
+        h.written = (b.live >> lane) & 1u;
+        h.killed = h.passed && !h.written;
+        replay_block(s, rec, b, h.replay);
+        if (h.passed) {
+            h.shading = shade_lane(ctx, material_of(s, rec, rec.pieces[b.piece].triangle), h.replay, lane);
+            if (h.written) {
+                depth = h.z;  // every draw of the frame writes depth
+                color = h.shading.Lo;
+            }
+        }
+        h.color_after = color;
+        px.history.push_back(std::move(h));
+        if (px.history.back().written) px.winner = int(px.history.size()) - 1;
+    }
+    // The resolve of conventions.md "Output", on this one pixel.
+    px.linear = color_of(rec.fb, x, y);
+    px.exposed = px.linear * s.exposure();
+    px.toned = tonemap(px.exposed, s.tonemap());
+    const float rgba[4] = {px.linear.r, px.linear.g, px.linear.b, 1.0f};
+    std::uint8_t out[4];
+    resolve_to_srgb8(rgba, 1, 1, s.exposure(), s.tonemap(), out);
+    std::memcpy(px.srgb8, out, 3);
+    return px;
+}
+
+namespace {
+
+void shading_text(std::ostringstream& o, const StepScene& s, const Recording& rec, const HistoryEntry& h) {
+    const std::uint32_t tri = rec.pieces[h.piece].triangle;
+    const BoundMaterial& bm = material_of(s, rec, tri);
+    const Material& m = *bm.m;
+    const LaneShading& sh = h.shading;
+    const MaterialSample& ms = sh.ms;
+    const SurfacePoint& sp = sh.sp;
+    o << "  geometric normal " << vec(ms.N_geom) << (sp.front_facing ? "" : " (back face: flipped)") << "\n";
+    o << "  uv " << vec(sp.uv) << ", d(uv)/dx " << vec(sp.duv_dx) << ", d(uv)/dy " << vec(sp.duv_dy)
+      << " (per 2x2 quad)\n";
+    if (bm.normal) {
+        const glm::vec3 N = glm::normalize(sp.N);
+        glm::vec3 T = glm::vec3(sp.T);
+        T = T - N * glm::dot(N, T);
+        const float len2 = glm::dot(T, T);
+        if (len2 > 1e-20f) {
+            T = T / std::sqrt(len2);
+            const float w = sp.T.w < 0.0f ? -1.0f : 1.0f;
+            const glm::vec3 B = glm::cross(N, T) * w;
+            o << "  tangent T " << vec(T) << " (w " << num(w) << "), bitangent B = cross(N, T) w " << vec(B) << "\n";
+        }
+        o << map_text("normal", bm.normal, sp.uv, sh.lods.normal, "  ");
+        const glm::vec4 tx = bm.normal->sample_trilinear(sp.uv.x, sp.uv.y, sh.lods.normal);
+        o << "  normal-map texel " << vec(glm::vec3(tx)) << " -> tangent space " << vec(glm::vec3(tx) * 2.0f - 1.0f)
+          << " (scale " << num(m.normal_scale) << ")\n";
+    }
+    o << "  mapped normal n " << vec(ms.N) << "\n";
+    o << map_text("base_color", bm.base_color, sp.uv, sh.lods.base_color, "  ");
+    o << map_text("metallic_roughness", bm.metallic_roughness, sp.uv, sh.lods.metallic_roughness, "  ");
+    o << map_text("roughness", bm.roughness, sp.uv, sh.lods.roughness, "  ");
+    o << map_text("metallic", bm.metallic, sp.uv, sh.lods.metallic, "  ");
+    o << map_text("occlusion", bm.occlusion, sp.uv, sh.lods.occlusion, "  ");
+    o << map_text("emissive", bm.emissive, sp.uv, sh.lods.emissive, "  ");
+    const float r = glm::clamp(ms.roughness, kMinPerceptualRoughness, 1.0f);
+    o << "  albedo " << vec(ms.albedo) << ", alpha " << num(ms.alpha);
+    if (m.alpha_mode == AlphaMode::Mask) o << " (mask cutoff " << num(m.alpha_cutoff) << ")";
+    o << "\n  roughness " << num(ms.roughness) << " (clamped " << num(r) << ", alpha r^2 " << num(r * r)
+      << "), metallic " << num(ms.metallic) << ", occlusion " << num(ms.occlusion) << "\n";
+    if (ms.conductor != Conductor::None) {
+        const ConductorIOR c = conductor_ior(ms.conductor);
+        o << "  conductor " << conductor_name(ms.conductor) << ": eta " << vec(c.eta) << " k " << vec(c.k) << "\n";
+    } else {
+        o << "  F0 " << vec(glm::mix(glm::vec3(f0_from_ior(ms.ior)), ms.albedo, ms.metallic)) << " (ior "
+          << num(ms.ior) << ")\n";
+    }
+    o << "  v " << vec(sh.inputs.v) << " (towards the eye " << vec(s.settings.camera.eye) << " from P " << vec(sp.P)
+      << ")\n";
+    for (std::size_t i = 0; i < sh.lights.size(); ++i) {
+        const LightStep& L = sh.lights[i];
+        const ShadingLight& src = s.settings.lights[i];
+        const BrdfTerms& t = L.terms;
+        o << "  light " << i << " (" << (src.point ? "point" : "sun") << "): l " << vec(L.l) << " radiance "
+          << vec(L.radiance) << "\n";
+        o << "    h " << vec(L.h) << "  n.l " << num(t.NoL) << "  n.v " << num(t.NoV) << "  n.h " << num(t.NoH)
+          << "  v.h " << num(t.VoH) << "\n";
+        o << "    D " << num(t.D) << "  " << (s.settings.model == BrdfModel::Gltf ? "V " : "G ") << num(t.G) << "  F "
+          << vec(t.F) << "  kd " << vec(t.kd) << "\n";
+        o << "    diffuse " << vec(t.diffuse) << "  specular " << vec(t.specular) << "\n";
+        o << "    contribution (diffuse + specular) * radiance * n.l = " << vec(L.contribution) << "\n";
+    }
+    o << "  emissive " << vec(ms.emissive) << "\n";
+    o << "  ambient " << vec(s.settings.ambient) << " * albedo * occlusion = " << vec(sh.ambient) << "\n";
+    o << "  shaded colour (emissive + contributions + ambient) " << vec(sh.Lo) << "\n";
+    if (!sh.matches_shade_surface) o << "  NOTE: shade_surface() gives a different value\n";
+}
+
+} // namespace
+
+std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExplanation& px) {
+    std::ostringstream o;
+    const int tile = rec.tile_of(px.x, px.y);
+    int lane = 0;
+    for (int l = 0; l < kBlockLanes; ++l)
+        if (lane_x(l) == (px.x & 3) && lane_y(l) == (px.y & 3)) lane = l;
+    o << "pixel " << px.x << " " << px.y << ": tile " << tile % rec.tiles_x << " " << tile / rec.tiles_x << ", block "
+      << (px.x & ~3) << " " << (px.y & ~3) << " lane " << lane << "\n";
+    o << "history: cleared to (0, 0, 0) depth 1, then " << px.history.size() << " fragment"
+      << (px.history.size() == 1 ? "" : "s") << " in submission order\n";
+    for (std::size_t i = 0; i < px.history.size(); ++i) {
+        const HistoryEntry& h = px.history[i];
+        const PieceRecord& p = rec.pieces[h.piece];
+        const TriangleRecord& tr = rec.triangles[p.triangle];
+        const DrawRecord& d = rec.draw_of(p.triangle);
+        const TriangleSetup& t = rec.setups[p.setup];
+        const SurfacePoint sp = PbrProgram::surface_point(h.replay.in, h.lane);
+        o << "  #" << i + 1 << " tri " << p.triangle;
+        if (tr.piece_count > 1) o << " piece " << (h.piece - tr.first_piece);
+        o << " (draw " << (&d - rec.draws.data()) << " " << quoted(mesh_name(s, rec, p.triangle)) << " prim "
+          << (p.triangle - d.first_triangle) << ", material " << quoted(material_of(s, rec, p.triangle).m->name)
+          << ", " << (t.front_facing ? "front" : "back") << " face)\n";
+        const int l = h.lane;
+        o << "     barycentrics screen (" << num(h.replay.bary[0][l]) << ", " << num(h.replay.bary[1][l]) << ", "
+          << num(h.replay.bary[2][l]) << ") perspective (" << num(h.replay.persp[0][l]) << ", "
+          << num(h.replay.persp[1][l]) << ", " << num(h.replay.persp[2][l]) << ")\n";
+        o << "     P " << vec(sp.P) << " N " << vec(sp.N) << " uv " << vec(sp.uv) << " T " << vec(sp.T) << "\n";
+        o << "     depth " << num(h.z) << " vs buffer " << num(h.depth_before) << ": ";
+        if (!h.passed) {
+            o << "failed the depth test (LESS)\n";
+            continue;
+        }
+        o << "passed; ";
+        if (h.killed)
+            o << "discarded by the shader (alpha " << num(h.shading.ms.alpha) << " below the cutoff)\n";
+        else
+            o << "shader out " << vec(h.shading.Lo) << ", colour " << vec(h.color_before) << " -> "
+              << vec(h.color_after) << "\n";
+        if (h.z != h.replay.in.z[l]) o << "     NOTE: recomputed depth " << num(h.replay.in.z[l]) << "\n";
+    }
+    if (px.winner < 0) {
+        o << "no fragment was written: the background\n";
+    } else {
+        const HistoryEntry& w = px.history[std::size_t(px.winner)];
+        o << "shading of #" << px.winner + 1 << " (tri " << rec.pieces[w.piece].triangle << "), lane " << w.lane
+          << " of its 4x4 block:\n";
+        shading_text(o, s, rec, w);
+        if (w.shading.Lo != px.linear) o << "  NOTE: the framebuffer holds " << vec(px.linear) << "\n";
+    }
+    o << "linear " << vec(px.linear) << "\n";
+    o << "exposure " << num(s.exposure()) << " -> " << vec(px.exposed) << "\n";
+    o << "tone map " << tonemap_name(s.tonemap()) << " -> " << vec(px.toned) << "\n";
+    o << "srgb8 " << int(px.srgb8[0]) << " " << int(px.srgb8[1]) << " " << int(px.srgb8[2]) << "\n";
+    return o.str();
+}
+
+json pixel_json(const StepScene& s, const Recording& rec, const PixelExplanation& px) {
+    json j;
+    j["x"] = px.x;
+    j["y"] = px.y;
+    json hist = json::array();
+    for (const HistoryEntry& h : px.history) {
+        json e;
+        e["tri"] = rec.pieces[h.piece].triangle;
+        e["mesh"] = mesh_name(s, rec, rec.pieces[h.piece].triangle);
+        e["depth"] = h.z;
+        e["result"] = !h.passed ? "depth test failed" : h.killed ? "discarded" : "written";
+        if (h.passed && !h.killed) e["out"] = j3(h.shading.Lo);
+        hist.push_back(e);
+    }
+    j["history"] = hist;
+    j["winner"] = px.winner;
+    j["linear"] = j3(px.linear);
+    j["srgb8"] = json::array({px.srgb8[0], px.srgb8[1], px.srgb8[2]});
+    j["text"] = pixel_text(s, rec, px);
+    return j;
+}
+
+} // namespace prast::stepper

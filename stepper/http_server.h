@@ -1,0 +1,24 @@
+// `step --serve`: the web page and its JSON API over the recorded frame, on
+// 127.0.0.1 only. Every request goes through the session (one at a time);
+// bad requests get a 4xx status with {"error": "..."} and never stop the
+// server.
+//
+//   GET /                      the page (stepper/web/, built in)
+//   GET /api/frame             sizes, counts and the `frame` text
+//   GET /api/stages            [{name, title, about}]
+//   GET /api/stage?name=NAME   a stage image (PNG)
+//   GET /api/upto?n=N          the frame after the first N triangles (PNG)
+//   GET /api/pixel?x=X&y=Y     a pixel's history and breakdown (and the `pixel X Y` text)
+//   GET /api/tri?n=N           a triangle's setup (and the `tri N` text)
+//   GET /api/tile?x=TX&y=TY    a tile's bins (and the `tile TX TY` text)
+#pragma once
+
+#include "stepper/session.h"
+
+namespace prast::stepper {
+
+// Serves until the process is stopped. Prints the URL on stdout; port 0
+// takes any free port. Returns 1 when the port cannot be bound.
+int serve(Session& session, int port);
+
+} // namespace prast::stepper

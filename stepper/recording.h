@@ -1,0 +1,104 @@
+// One recording of a frame: what every stage of the pipeline did, heard
+// through a stage observer (raster/observer.h) while the real frame is drawn.
+// Kept compact: per draw the vertex stage's output; per triangle its fate and
+// per post-clip piece the TriangleSetup the pipeline built and the tiles it
+// was binned to; per tile, in the order the tile ran them, the 4x4 blocks
+// with their coverage, depth-test and written masks and the depths of the
+// covered pixels. Barycentrics, varyings and shading are recomputed on
+// demand from these (replay.h), with the pipeline's own data and functions.
+//
+// Observer calls come from worker threads: vertex and triangle events are
+// keyed by their (draw-local) index, block events go to their tile's list
+// (a tile is run by one thread at a time), so the recording is the same for
+// any thread count.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "raster/draw_state.h"
+#include "raster/framebuffer.h"
+#include "raster/observer.h"
+#include "raster/setup.h"
+#include "raster/stats.h"
+#include "shading/pbr_program.h"
+#include "stepper/scene_setup.h"
+
+namespace prast::stepper {
+
+constexpr int kStride = 4 + kPbrVaryings;  // floats per vertex: clip xyzw, varyings
+constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+
+struct DrawRecord {
+    int mesh = -1;                      // index into the scene's meshes
+    DrawState state;
+    std::uint32_t first_triangle = 0;   // global number of the draw's triangle 0
+    std::uint32_t triangle_count = 0;
+    std::uint32_t vertex_count = 0;
+    std::vector<float> vertices;        // kStride floats per vertex, as the vertex stage wrote them
+};
+
+// A post-clip piece of a triangle (an unclipped triangle is one piece).
+struct PieceRecord {
+    std::uint32_t triangle = 0;         // global triangle number
+    TriangleFate fate = TriangleFate::SetUp;
+    std::uint32_t setup = kNone;        // index into Recording::setups when set up
+    std::uint32_t first_tile = 0, tile_count = 0;  // into Recording::piece_tiles
+};
+
+struct TriangleRecord {
+    TriangleFate fate = TriangleFate::Invalid;  // SetUp when any piece was set up
+    bool clipped = false;
+    bool seen = false;                  // false: beyond a triangle limit, never submitted
+    std::uint32_t first_piece = 0, piece_count = 0;
+};
+
+// One 4x4 block of one triangle piece in a tile: covered, passed the depth
+// test, written (passed and not discarded by the shader).
+struct BlockRecord {
+    std::uint32_t piece = 0;            // index into Recording::pieces
+    std::uint16_t bx = 0, by = 0;       // top-left pixel
+    std::uint16_t mask = 0, pass = 0, live = 0;
+    std::uint32_t z = 0;                // first covered lane's depth in TileRecord::z (lane order)
+};
+
+struct TileRecord {
+    std::vector<std::uint32_t> pieces;  // binned pieces, in the order the tile ran them
+    std::vector<BlockRecord> blocks;    // in the order the tile ran them
+    std::vector<float> z;               // window depth of each covered lane of each block
+};
+
+struct Recording {
+    int width = 0, height = 0, tile_size = 0, tiles_x = 0, tiles_y = 0;
+    std::vector<DrawRecord> draws;
+    std::vector<TriangleRecord> triangles;  // global submission order
+    std::vector<PieceRecord> pieces;        // grouped by triangle, pieces in fan order
+    std::vector<TriangleSetup> setups;      // as setup_triangle() built them
+    std::vector<std::uint32_t> piece_tiles; // tiles of each piece, in binning order
+    std::vector<TileRecord> tiles;
+    FrameStats stats;                       // the renderer's counters for the frame
+    Framebuffer fb;                         // the frame itself (linear colour, depth)
+    double record_ms = 0.0;                 // wall time of the recorded frame
+
+    int tile_of(int x, int y) const { return (y / tile_size) * tiles_x + x / tile_size; }
+    // Which draw holds global triangle `tri`.
+    const DrawRecord& draw_of(std::uint32_t tri) const;
+    std::uint32_t triangle_count() const { return std::uint32_t(triangles.size()); }
+    std::size_t bytes() const;              // memory held, without the framebuffer
+};
+
+// Draws the frame with a recording observer; `rec` is filled.
+void record_frame(StepScene& s, Recording& rec);
+
+// The frame after the first `triangles` triangles (submission order).
+void draw_upto(StepScene& s, std::uint64_t triangles, Framebuffer& fb);
+
+// The frame as `render` draws it (SceneRenderer, no observer): the cost
+// comparison and the check that the recorded frame is the same.
+void draw_plain(StepScene& s, Framebuffer& fb);
+
+} // namespace prast::stepper

@@ -1,0 +1,75 @@
+// Recomputing what the recording left out, with the pipeline's own data and
+// functions: a triangle's outcodes and clipped polygon (raster/clip.h), the
+// vertices of each set-up piece, the barycentrics, depth and varyings of a
+// 4x4 block exactly as rasterize.h's shade_block() computes them (the same
+// float operations in the same order), and the shading of one lane with
+// shading/surface.h's scalar path, which is bit-identical to the lane path
+// `render` uses. The `verify` command re-renders the frame and compares all
+// of it with the pipeline's own values.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "raster/clip.h"
+#include "raster/fragment.h"
+#include "shading/surface.h"
+#include "stepper/recording.h"
+
+namespace prast::stepper {
+
+// Clipping of one triangle, recomputed from the recorded vertices.
+struct ClipReplay {
+    bool valid = false;                 // finite positions, indices in range
+    std::uint32_t index[3] = {0, 0, 0}; // vertex indices in the mesh
+    std::uint32_t outcode[3] = {0, 0, 0};
+    std::uint32_t planes = 0;           // planes clipped against (kClipNeededBits)
+    int count = 0;                      // polygon vertices after clipping (3 when not clipped)
+    float polygon[kMaxClippedVertices][kStride] = {};
+};
+ClipReplay replay_clip(const StepScene& s, const Recording& rec, std::uint32_t tri);
+
+// The three vertices of a set-up piece in TriangleSetup order (vtx[0..2]).
+void piece_vertices(const StepScene& s, const Recording& rec, std::uint32_t piece, float out[3][kStride]);
+
+// Window position of a vertex, snapped to 1/256 pixel as setup_triangle() does.
+struct SnappedVertex {
+    double x_win = 0, y_win = 0;
+    std::int64_t fx = 0, fy = 0;        // 1/256-pixel units
+    float z = 0, inv_w = 0;
+};
+SnappedVertex snap_vertex(const float* clip, int width, int height);
+
+// The fragment block of a recorded block as the shader received it.
+struct ReplayedBlock {
+    FragmentBlock<kPbrVaryings> in;
+    float bary[3][kBlockLanes];         // screen-space barycentrics
+    float persp[3][kBlockLanes];        // perspective-correct weights (w0 = q0 / sum, shown only)
+};
+void replay_block(const StepScene& s, const Recording& rec, const BlockRecord& b, ReplayedBlock& out);
+
+// One lane's shading, step by step, as shade_surface() computes it.
+struct LightStep {
+    glm::vec3 l{0.0f}, h{0.0f}, radiance{0.0f};
+    BrdfTerms terms;
+    glm::vec3 contribution{0.0f};       // f * radiance * n.l
+};
+struct LaneShading {
+    SurfacePoint sp;
+    MaterialLods lods;
+    MaterialSample ms;
+    bool killed = false;                // alpha MASK discarded it
+    BrdfInputs inputs;
+    std::vector<LightStep> lights;
+    glm::vec3 ambient{0.0f};            // ambient * albedo * occlusion
+    glm::vec3 Lo{0.0f};                 // the colour the shader wrote
+    bool matches_shade_surface = true;  // Lo == shade_surface(): always, or the stepper is wrong
+};
+LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const ReplayedBlock& rb, int lane);
+
+// The material a triangle's draw uses.
+const BoundMaterial& material_of(const StepScene& s, const Recording& rec, std::uint32_t tri);
+
+} // namespace prast::stepper

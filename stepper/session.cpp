@@ -1,0 +1,322 @@
+// The command interpreter; see session.h.
+#include "stepper/session.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <mutex>
+#include <sstream>
+
+#include "scene/write_image.h"
+#include "shading/tonemap.h"
+#include "stepper/explain.h"
+#include "stepper/format.h"
+#include "stepper/frame_loop.h"
+#include "stepper/replay.h"
+#include "stepper/stages.h"
+
+namespace prast::stepper {
+
+std::vector<std::string> split_words(const std::string& line) {
+    std::vector<std::string> words;
+    std::string w;
+    for (char c : line) {
+        if (c == ' ' || c == '\t' || c == '\r' || c == '\n') {
+            if (!w.empty()) words.push_back(w);
+            w.clear();
+        } else {
+            w += c;
+        }
+    }
+    if (!w.empty()) words.push_back(w);
+    return words;
+}
+
+bool parse_int(const std::string& word, long lo, long hi, long& out) {
+    // Digits only (an optional '-'), at most 18 of them: no overflow, no "1e3", no "0x10".
+    std::size_t i = word.size() > 1 && word[0] == '-' ? 1 : 0;
+    if (word.empty() || word.size() - i > 18 || i == word.size()) return false;
+    long v = 0;
+    for (; i < word.size(); ++i) {
+        if (word[i] < '0' || word[i] > '9') return false;
+        v = v * 10 + (word[i] - '0');
+    }
+    if (word[0] == '-') v = -v;
+    if (v < lo || v > hi) return false;
+    out = v;
+    return true;
+}
+
+namespace {
+
+Reply error(const std::string& message) { return Reply{false, false, "error: " + message + "\n"}; }
+
+std::string count_range(long n) { return n > 0 ? "0.." + std::to_string(n - 1) : "none"; }
+
+// Checks a re-rendered frame against the recording: the same events in the
+// same order, and the values the stepper recomputes equal to the pipeline's.
+class VerifyObserver {
+public:
+    static constexpr bool enabled = true;
+
+    VerifyObserver(const StepScene& s, const Recording& rec)
+        : s_(s), rec_(rec), ctx_(shading_context(s.settings)), cursor_(rec.tiles.size(), 0) {}
+
+    void begin_draw(int, std::uint32_t, std::uint32_t, std::uint32_t, const DrawState&) { ++draw_; }
+
+    void vertex(std::uint32_t v, const float* clip, const float* var, int nv) {
+        const float* r = &rec_.draws[std::size_t(draw_ - 1)].vertices[std::size_t(v) * kStride];
+        ++vertices_;
+        if (std::memcmp(r, clip, 4 * sizeof(float)) || std::memcmp(r + 4, var, std::size_t(nv) * sizeof(float)))
+            fail("vertex " + std::to_string(v) + " of draw " + std::to_string(draw_ - 1) + " differs");
+    }
+    void triangle(std::uint32_t, TriangleFate, bool, const TriangleSetup*) {}
+    void binned(std::uint32_t, int) {}
+
+    void fragments(std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass, const float* z) {
+        const std::size_t tile = std::size_t(rec_.tile_of(bx, by));
+        const TileRecord& t = rec_.tiles[tile];
+        ++blocks_;
+        if (cursor_[tile] >= t.blocks.size()) return fail("tile " + std::to_string(tile) + " has more blocks");
+        const BlockRecord& b = t.blocks[cursor_[tile]++];
+        const std::uint32_t tri = rec_.draws[std::size_t(draw_ - 1)].first_triangle + prim;
+        bool same = b.bx == bx && b.by == by && b.mask == mask && b.pass == pass && rec_.pieces[b.piece].triangle == tri;
+        std::size_t k = b.z;
+        for (std::uint32_t m = mask; m && same; m &= m - 1) same = t.z[k++] == z[__builtin_ctz(m)];
+        if (!same) fail("block " + std::to_string(bx) + "," + std::to_string(by) + " of tri " + std::to_string(tri) +
+                        " differs from the recording");
+    }
+
+    template <int NV>
+    void shaded(const FragmentBlock<NV>& in, const FragmentOut& out, std::uint32_t live) {
+        const std::size_t tile = std::size_t(rec_.tile_of(in.x, in.y));
+        const BlockRecord& b = rec_.tiles[tile].blocks[cursor_[tile] - 1];
+        ReplayedBlock rb;
+        replay_block(s_, rec_, b, rb);
+        ++shaded_blocks_;
+        const std::string where = "block " + std::to_string(in.x) + "," + std::to_string(in.y) + " of tri " +
+                                  std::to_string(rec_.pieces[b.piece].triangle);
+        if (live != b.live) fail(where + ": written lanes differ");
+        if (std::memcmp(rb.in.var, in.var, sizeof in.var) || std::memcmp(rb.in.z, in.z, sizeof in.z) ||
+            rb.in.mask != in.mask || rb.in.front_facing != in.front_facing || rb.in.prim_id != in.prim_id)
+            fail(where + ": recomputed varyings or depths differ from the rasterizer's");
+        const BoundMaterial& bm = material_of(s_, rec_, rec_.pieces[b.piece].triangle);
+        for (std::uint32_t m = live; m; m &= m - 1) {
+            const int l = __builtin_ctz(m);
+            const LaneShading sh = shade_lane(ctx_, bm, rb, l);
+            ++pixels_;
+            const float c[3] = {out.r[l], out.g[l], out.b[l]};
+            if (std::memcmp(c, &sh.Lo, sizeof c) || sh.killed || !sh.matches_shade_surface)
+                fail(where + " lane " + std::to_string(l) + ": recomputed shading " + vec(sh.Lo) +
+                     " differs from the shader's " + vec(glm::vec3(c[0], c[1], c[2])));
+        }
+    }
+
+    void fail(const std::string& what) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (failures_++ == 0) first_ = what;
+    }
+
+    const StepScene& s_;
+    const Recording& rec_;
+    const ShadingContext ctx_;
+    std::vector<std::size_t> cursor_;
+    int draw_ = 0;
+    std::atomic<std::uint64_t> vertices_{0}, blocks_{0}, shaded_blocks_{0}, pixels_{0};
+    std::mutex mutex_;
+    std::uint64_t failures_ = 0;
+    std::string first_;
+};
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+} // namespace
+
+Reply Session::help() const {
+    std::string t =
+        "commands (a triangle number N counts in submission order over all draws, 0.." +
+        std::to_string(long(rec_.triangle_count()) - 1) + "):\n"
+        "  help                 this list\n"
+        "  frame                the frame's counters, camera, lights and the recording's size\n"
+        "  tri N                triangle N: clip coordinates, clipping, fixed-point setup, edges, bins, tile walk\n"
+        "  tile X Y             the triangles binned to tile X Y (tile columns and rows), in order\n"
+        "  pixel X Y            the history of pixel X Y and the shading breakdown of the winning fragment\n"
+        "  upto N [FILE]        write the image after the first N triangles (default upto-N.png)\n"
+        "  stage NAME [FILE]    write one stage image (default stage-NAME.png); NAME is one of:\n"
+        "                      ";
+    int col = 22;
+    for (const StageInfo& st : stage_list()) {
+        const int len = int(std::strlen(st.name)) + 1;
+        if (col + len > 100) {
+            t += "\n                      ";
+            col = 22;
+        }
+        t += " ";
+        t += st.name;
+        col += len;
+    }
+    t += "\n"
+         "  verify               re-render the frame and compare every recomputed number with the pipeline's\n"
+         "  cost                 time and memory of a recording against a plain frame\n"
+         "  quit                 end the session (so does the end of the input)\n";
+    return Reply{true, false, t};
+}
+
+Reply Session::run(const std::string& line) {
+    const std::vector<std::string> w = split_words(line);
+    if (w.empty() || w[0][0] == '#') return Reply{};
+    const std::string& cmd = w[0];
+    auto args = [&](std::size_t lo, std::size_t hi) { return w.size() - 1 >= lo && w.size() - 1 <= hi; };
+    long a = 0, b = 0;
+    if (cmd == "help") return help();
+    if (cmd == "quit" || cmd == "exit") return Reply{true, true, ""};
+    if (cmd == "frame") {
+        if (!args(0, 0)) return error("frame takes no arguments");
+        return Reply{true, false, frame_text(s_, rec_)};
+    }
+    if (cmd == "tri") {
+        if (!args(1, 1)) return error("usage: tri N");
+        if (!parse_int(w[1], 0, long(rec_.triangle_count()) - 1, a))
+            return error("tri '" + w[1] + "': not a triangle number (" + count_range(rec_.triangle_count()) + ")");
+        return Reply{true, false, triangle_text(s_, rec_, std::uint32_t(a))};
+    }
+    if (cmd == "tile") {
+        if (!args(2, 2)) return error("usage: tile X Y (tile column and row)");
+        if (!parse_int(w[1], 0, rec_.tiles_x - 1, a) || !parse_int(w[2], 0, rec_.tiles_y - 1, b))
+            return error("tile '" + w[1] + " " + w[2] + "': outside the " + std::to_string(rec_.tiles_x) + "x" +
+                         std::to_string(rec_.tiles_y) + " tiles");
+        return Reply{true, false, tile_text(s_, rec_, int(a), int(b))};
+    }
+    if (cmd == "pixel") {
+        if (!args(2, 2)) return error("usage: pixel X Y");
+        if (!parse_int(w[1], 0, rec_.width - 1, a) || !parse_int(w[2], 0, rec_.height - 1, b))
+            return error("pixel '" + w[1] + " " + w[2] + "': outside the " + std::to_string(rec_.width) + "x" +
+                         std::to_string(rec_.height) + " image");
+        return Reply{true, false, pixel_text(s_, rec_, explain_pixel(s_, rec_, int(a), int(b)))};
+    }
+    if (cmd == "upto") {
+        if (!args(1, 2)) return error("usage: upto N [FILE]");
+        if (!parse_int(w[1], 0, long(rec_.triangle_count()), a))
+            return error("upto '" + w[1] + "': not a triangle count (0.." + std::to_string(rec_.triangle_count()) + ")");
+        const std::string file = w.size() > 2 ? w[2] : "upto-" + std::to_string(a) + ".png";
+        try {
+            const std::vector<std::uint8_t> rgba = upto_rgba(std::uint64_t(a));
+            write_png_atomic(file, rec_.width, rec_.height, rgba.data());
+        } catch (const std::exception& e) {
+            return error(e.what());
+        }
+        return Reply{true, false, "upto " + std::to_string(a) + ": wrote " + file + " (the frame after the first " +
+                                      std::to_string(a) + " of " + std::to_string(rec_.triangle_count()) +
+                                      " triangles)\n"};
+    }
+    if (cmd == "stage") {
+        if (!args(1, 2)) return error("usage: stage NAME [FILE]");
+        if (!find_stage(w[1])) return error("stage '" + w[1] + "': unknown (help lists the stages)");
+        const std::string file = w.size() > 2 ? w[2] : "stage-" + w[1] + ".png";
+        std::vector<std::uint8_t> rgba;
+        draw_stage(s_, rec_, w[1], rgba);
+        try {
+            write_png_atomic(file, rec_.width, rec_.height, rgba.data());
+        } catch (const std::exception& e) {
+            return error(e.what());
+        }
+        return Reply{true, false, "stage " + w[1] + ": wrote " + file + "\n"};
+    }
+    if (cmd == "verify") {
+        if (!args(0, 0)) return error("verify takes no arguments");
+        return verify();
+    }
+    if (cmd == "cost") {
+        if (!args(0, 0)) return error("cost takes no arguments");
+        return cost();
+    }
+    std::string shown = cmd.size() > 40 ? cmd.substr(0, 40) + "..." : cmd;
+    for (char& c : shown)
+        if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) >= 127) c = '?';
+    return error("unknown command '" + shown + "' (help lists the commands)");
+}
+
+std::vector<std::uint8_t> Session::stage_png(const std::string& name) {
+    std::vector<std::uint8_t> rgba;
+    draw_stage(s_, rec_, name, rgba);
+    return encode_png(rec_.width, rec_.height, rgba.data());
+}
+
+std::vector<std::uint8_t> Session::upto_rgba(std::uint64_t triangles) {
+    Framebuffer fb;
+    draw_upto(s_, triangles, fb);
+    std::vector<std::uint8_t> rgba(std::size_t(fb.width) * fb.height * 4);
+    resolve_to_srgb8(fb.color.data(), fb.width, fb.height, s_.exposure(), s_.tonemap(), rgba.data());
+    return rgba;
+}
+
+std::vector<std::uint8_t> Session::upto_png(std::uint64_t triangles) {
+    return encode_png(rec_.width, rec_.height, upto_rgba(triangles).data());
+}
+
+Reply Session::verify() {
+    VerifyObserver obs(s_, rec_);
+    Framebuffer fb(rec_.width, rec_.height);
+    draw_frame(s_, fb, obs);
+    for (std::size_t t = 0; t < rec_.tiles.size(); ++t)
+        if (obs.cursor_[t] != rec_.tiles[t].blocks.size()) obs.fail("tile " + std::to_string(t) + " has fewer blocks");
+    if (std::memcmp(fb.color.data(), rec_.fb.color.data(), fb.color.size() * sizeof(float)) ||
+        fb.depth != rec_.fb.depth)
+        obs.fail("the re-rendered framebuffer differs from the recorded one");
+    Framebuffer plain;
+    draw_plain(s_, plain);
+    if (std::memcmp(plain.color.data(), rec_.fb.color.data(), plain.color.size() * sizeof(float)))
+        obs.fail("SceneRenderer::render draws a different frame");
+    std::ostringstream o;
+    o << "verify: re-rendered the frame and compared it with the recording\n"
+      << "  " << obs.vertices_ << " vertices: clip coordinates and varyings\n"
+      << "  " << obs.blocks_ << " blocks: coverage, depth-test masks and depths, in each tile's order\n"
+      << "  " << obs.shaded_blocks_ << " shaded blocks: recomputed barycentrics, depths and varyings of all 16 lanes\n"
+      << "  " << obs.pixels_ << " written pixels: recomputed shading (scalar path) against the shader's output\n"
+      << "  the framebuffer against the recording's and SceneRenderer::render's\n";
+    if (obs.failures_) {
+        o << "verify: FAILED (" << obs.failures_ << " differences; first: " << obs.first_ << ")\n";
+        return Reply{false, false, o.str()};
+    }
+    o << "verify: ok, all identical\n";
+    return Reply{true, false, o.str()};
+}
+
+Reply Session::cost() {
+    constexpr int kRuns = 5;
+    std::vector<double> plain_ms, record_ms;
+    Framebuffer fb;
+    for (int i = 0; i < kRuns; ++i) {
+        auto t0 = std::chrono::steady_clock::now();
+        draw_plain(s_, fb);
+        plain_ms.push_back(ms_since(t0));
+        Recording r;
+        record_frame(s_, r);
+        record_ms.push_back(r.record_ms);
+    }
+    char buf[512];
+    const double plain = median(plain_ms), recorded = median(record_ms);
+    std::snprintf(buf, sizeof buf,
+                  "cost of a recording, %dx%d, %d thread%s, median of %d frames:\n"
+                  "  plain frame (SceneRenderer::render) %.1f ms\n"
+                  "  recorded frame %.1f ms (%.2fx)\n"
+                  "  recording %zu bytes (%.1f MiB), plus the frame's own framebuffer %zu bytes\n",
+                  rec_.width, rec_.height, s_.renderer->threads(), s_.renderer->threads() == 1 ? "" : "s", kRuns,
+                  plain, recorded, recorded / plain, rec_.bytes(), double(rec_.bytes()) / 1048576.0,
+                  (rec_.fb.color.size() + rec_.fb.depth.size()) * sizeof(float));
+    std::ostringstream o;
+    o << buf;
+    return Reply{true, false, o.str()};
+}
+
+} // namespace prast::stepper

@@ -1,0 +1,49 @@
+// The command interpreter of `step`: one command line in, its text out.
+// The terminal front end feeds it standard input; the web server calls it
+// (and the JSON forms in explain.h) for each request. Bad commands get a
+// one-line "error: ..." and the session goes on.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "stepper/recording.h"
+
+namespace prast::stepper {
+
+struct Reply {
+    bool ok = true;
+    bool quit = false;
+    std::string text;   // lines ending in '\n'; an error is one line "error: ..."
+};
+
+class Session {
+public:
+    Session(StepScene& scene, Recording& rec) : s_(scene), rec_(rec) {}
+
+    Reply run(const std::string& line);
+
+    // The PNG bytes of a stage, or of the frame after the first n triangles.
+    std::vector<std::uint8_t> stage_png(const std::string& name);
+    std::vector<std::uint8_t> upto_png(std::uint64_t triangles);
+    std::vector<std::uint8_t> upto_rgba(std::uint64_t triangles);
+
+    StepScene& scene() { return s_; }
+    const Recording& recording() const { return rec_; }
+
+private:
+    Reply help() const;
+    Reply cost();
+    Reply verify();
+
+    StepScene& s_;
+    Recording& rec_;
+};
+
+// Splits a command line at spaces and tabs.
+std::vector<std::string> split_words(const std::string& line);
+// A whole word as an integer in [lo, hi].
+bool parse_int(const std::string& word, long lo, long hi, long& out);
+
+} // namespace prast::stepper

@@ -1,0 +1,122 @@
+// 8-bit PNGs are decoded by libpng (scene/image.cpp); stb_image remains the
+// reference for what an image holds. Every PNG flavour (palette with and
+// without transparency, grey at 1, 2, 4 and 8 bits, grey and RGB with a tRNS
+// colour key, grey+alpha, RGB, RGBA, Adam7 interlacing) decodes to exactly
+// stb_image's channels and bytes.
+#include <doctest/doctest.h>
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <png.h>
+#include <stb_image.h>
+
+#include "scene/image.h"
+
+using namespace prast;
+
+namespace {
+
+void append_png(png_structp png, png_bytep data, png_size_t n) {
+    auto* out = static_cast<std::vector<unsigned char>*>(png_get_io_ptr(png));
+    out->insert(out->end(), data, data + n);
+}
+
+struct Flavour {
+    const char* name;
+    int colour_type, bit_depth;
+    bool trns, interlace;
+};
+
+// Writes a w x h PNG of one flavour, with packed samples from `rng`.
+std::vector<unsigned char> write_flavour(const Flavour& f, int w, int h, std::mt19937& rng) {
+    std::vector<unsigned char> out;
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png_create_info_struct(png);
+    REQUIRE(png);
+    REQUIRE(info);
+    png_set_write_fn(png, &out, append_png, nullptr);
+    png_set_IHDR(png, info, png_uint_32(w), png_uint_32(h), f.bit_depth, f.colour_type,
+                 f.interlace ? PNG_INTERLACE_ADAM7 : PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
+    if (f.colour_type == PNG_COLOR_TYPE_PALETTE) {
+        png_color palette[16];
+        for (int i = 0; i < 16; ++i) palette[i] = {png_byte(i * 16), png_byte(255 - i * 9), png_byte(i * 5)};
+        png_set_PLTE(png, info, palette, 16);
+        if (f.trns) {
+            png_byte alpha[5] = {0, 50, 100, 150, 200};
+            png_set_tRNS(png, info, alpha, 5, nullptr);
+        }
+    } else if (f.trns) {
+        png_color_16 key{};
+        key.gray = 1;
+        key.red = 3; key.green = 5; key.blue = 7;
+        png_set_tRNS(png, info, nullptr, 0, &key);
+    }
+    png_write_info(png, info);
+    const int channels = f.colour_type == PNG_COLOR_TYPE_RGB ? 3 : f.colour_type == PNG_COLOR_TYPE_RGBA ? 4
+                         : f.colour_type == PNG_COLOR_TYPE_GRAY_ALPHA ? 2 : 1;
+    const std::size_t row_bytes = (std::size_t(w) * std::size_t(channels) * std::size_t(f.bit_depth) + 7) / 8;
+    std::vector<std::vector<png_byte>> rows;
+    rows.assign(static_cast<std::size_t>(h), std::vector<png_byte>(row_bytes));
+    const int max_index = f.colour_type == PNG_COLOR_TYPE_PALETTE ? 15 : (1 << f.bit_depth) - 1;
+    for (auto& row : rows) {
+        // Small values often, so that the tRNS keys are hit.
+        for (png_byte& b : row) b = png_byte(rng() % 4 == 0 ? 0x13 : rng());
+        // 4-bit palette indices are all below 16, the palette's size; 8-bit ones are folded.
+        if (f.bit_depth == 8 && f.colour_type == PNG_COLOR_TYPE_PALETTE)
+            for (png_byte& b : row) b = png_byte(b % (max_index + 1));
+    }
+    std::vector<png_bytep> pointers;
+    for (auto& row : rows) pointers.push_back(row.data());
+    png_write_image(png, pointers.data());
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    return out;
+}
+
+} // namespace
+
+TEST_SUITE("texture") {
+
+TEST_CASE("libpng decodes every 8-bit PNG flavour exactly as stb_image does") {
+    const Flavour flavours[] = {
+        {"palette", PNG_COLOR_TYPE_PALETTE, 8, false, false},
+        {"palette+tRNS", PNG_COLOR_TYPE_PALETTE, 8, true, false},
+        {"palette 4-bit", PNG_COLOR_TYPE_PALETTE, 4, false, false},
+        {"grey 1-bit", PNG_COLOR_TYPE_GRAY, 1, false, false},
+        {"grey 2-bit", PNG_COLOR_TYPE_GRAY, 2, false, false},
+        {"grey 4-bit", PNG_COLOR_TYPE_GRAY, 4, false, false},
+        {"grey", PNG_COLOR_TYPE_GRAY, 8, false, false},
+        {"grey+tRNS", PNG_COLOR_TYPE_GRAY, 8, true, false},
+        {"grey+alpha", PNG_COLOR_TYPE_GRAY_ALPHA, 8, false, false},
+        {"RGB", PNG_COLOR_TYPE_RGB, 8, false, false},
+        {"RGB+tRNS", PNG_COLOR_TYPE_RGB, 8, true, false},
+        {"RGBA", PNG_COLOR_TYPE_RGBA, 8, false, false},
+        {"RGB interlaced", PNG_COLOR_TYPE_RGB, 8, false, true},
+        {"grey 2-bit interlaced", PNG_COLOR_TYPE_GRAY, 2, false, true},
+    };
+    std::mt19937 rng(5u);
+    for (const Flavour& f : flavours)
+        for (int size : {1, 7, 33, 200}) {
+            INFO(f.name, " ", size, "x", size + 2);
+            const std::vector<unsigned char> png = write_flavour(f, size, size + 2, rng);
+            int w = 0, h = 0, comp = 0;
+            stbi_uc* ref = stbi_load_from_memory(png.data(), int(png.size()), &w, &h, &comp, 0);
+            REQUIRE(ref != nullptr);
+            ImageSource src;
+            src.bytes = png;
+            src.name = f.name;
+            const Image img = decode_image(src, true);
+            CHECK(img.channels == comp);
+            CHECK(img.srgb);
+            REQUIRE(img.width == w);
+            REQUIRE(img.height == h);
+            CHECK(img.pixels == std::vector<std::uint8_t>(ref, ref + std::size_t(w) * std::size_t(h) * std::size_t(comp)));
+            stbi_image_free(ref);
+        }
+}
+
+} // TEST_SUITE
