@@ -1,5 +1,5 @@
 // Writes the seed corpora of the harnesses: `fuzz_make_seeds OUT` fills
-// OUT/obj, OUT/gltf, OUT/png, OUT/jpeg, OUT/hdr and OUT/cli with small valid
+// OUT/obj, OUT/gltf, OUT/png, OUT/jpeg, OUT/hdr, OUT/cli and OUT/step with small valid
 // inputs that reach every branch the fuzzers should start from (materials
 // and maps, every glTF accessor kind, each image channel count, the HDR
 // run-length and flat paths, every render flag). Made by the project, so no
@@ -225,6 +225,12 @@ void cli_seeds() {
     }
 }
 
+void step_seeds() {
+    put("step", "overview", "help\nframe\ntri 0\ntile 0 0\npixel 24 16\n");
+    put("step", "stages", "stage depth\nstage coverage\nupto 3\nverify\n");
+    put("step", "errors", "tri -1\ntile 99 0\npixel 48 0\nupto x\nstage nope\nbogus\n# comment\nquit\n");
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -237,5 +243,6 @@ int main(int argc, char** argv) {
     obj_seeds();
     gltf_seeds();
     cli_seeds();
+    step_seeds();
     return 0;
 }

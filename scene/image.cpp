@@ -384,6 +384,9 @@ const float* unorm8_decode_table() {
 
 namespace {
 
+// Twice the densest JPEG possible (512 texels a byte, see decode_image).
+constexpr std::int64_t kMaxJpegTexelsPerByte = 1024;
+
 // "" when stb_image 2.27 may see these bytes; else "cannot decode FORMAT
 // image: why".
 std::string stb_unsafe(const unsigned char* data, std::size_t size) {
@@ -439,6 +442,13 @@ Image decode_image(const ImageSource& src, bool srgb) {
                         std::to_string(h) + " = " + std::to_string(texels) +
                         " texels, more than the limit of " + std::to_string(kMaxImageTexels) +
                         " (2^28)");
+    // A JPEG needs at least a bit per 8x8 block (a progressive DC scan), so
+    // no file holds more than 512 texels a byte; a small file that claims
+    // more would keep stb_image decoding made-up data for seconds.
+    if (looks_like_jpeg(data, bytes->size()) && texels > kMaxJpegTexelsPerByte * std::int64_t(bytes->size()))
+        throw LoadError(name + ": cannot decode JPEG image: " + std::to_string(w) + "x" + std::to_string(h) +
+                        " texels from only " + std::to_string(bytes->size()) + " bytes (a JPEG holds at most " +
+                        std::to_string(kMaxJpegTexelsPerByte) + " texels a byte)");
 
     // Decode with the file's own channel count.
     struct StbiFree {

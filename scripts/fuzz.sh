@@ -1,9 +1,10 @@
 #!/bin/sh
 # Fuzzes every input parser of prast with libFuzzer: the OBJ+MTL loader, the
-# glTF/.glb loader, the PNG, JPEG and Radiance HDR decoders and render's
-# command line, each for SECONDS (default 60), one after the other.
+# glTF/.glb loader, the PNG, JPEG and Radiance HDR decoders, render's command
+# line and the stepper's command interpreter, each for SECONDS (default 60),
+# one after the other.
 #
-#   scripts/fuzz.sh SECONDS [HARNESS...]     HARNESS: obj gltf png jpeg hdr cli
+#   scripts/fuzz.sh SECONDS [HARNESS...]     HARNESS: obj gltf png jpeg hdr cli step
 #
 # Builds build-fuzz/ with clang (apt-get install clang libclang-rt-14-dev),
 # writes the project's seed corpora (fuzz/make_seeds.cpp) to build-fuzz/seeds,
@@ -17,7 +18,7 @@ set -e
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
 [ $# -gt 0 ] && shift
-harnesses=${*:-obj gltf png jpeg hdr cli}
+harnesses=${*:-obj gltf png jpeg hdr cli step}
 out=build-fuzz
 export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}"
 if [ ! -f $out/CMakeCache.txt ]; then

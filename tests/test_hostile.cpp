@@ -517,6 +517,16 @@ TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused be
                          LoadError);
     int w = 0, h = 0;
     CHECK(!image_dimensions(src, w, h));  // stbi_info would read the tables too
+    // A small file claiming millions of texels (found by fuzz_jpeg: stb
+    // decoded made-up data for seconds) is refused from its header.
+    src.name = "dense.jpg";
+    src.bytes = test::read_bytes(std::string(PRAST_SOURCE_DIR) +
+                                 "/tests/fuzz-regressions/jpeg/small-file-claims-3.7-million-texels");
+    REQUIRE(src.bytes.size() == 1406);
+    CHECK_THROWS_WITH_AS(decode_image(src, true),
+                         "dense.jpg: cannot decode JPEG image: 2081x1791 texels from only 1406 bytes (a JPEG holds "
+                         "at most 1024 texels a byte)",
+                         LoadError);
     // Not JPEG data, even with the pair in it: no opinion.
     const unsigned char other[] = {0x89, 'P', 'N', 'G', 0xFF, 0xC4, 0, 3, 0, 255, 255};
     CHECK(check_jpeg_data(other, sizeof other) == "");
