@@ -451,9 +451,9 @@ int run(int argc, char** argv) {
     if (plan.total() > budget)
         return fail(kExitBadFile,
                     (opt.scene.empty() ? std::string("the built-in scene") : opt.scene) + ": the render needs about " +
-                        std::to_string(plan.total()) + " bytes (scene " + std::to_string(plan.scene) + ", " +
-                        std::to_string(plan.images) + " textures of " + std::to_string(plan.texels) + " texels " +
-                        std::to_string(plan.textures) + ", drawing " + std::to_string(plan.pipeline) + ", image " +
+                        std::to_string(plan.total()) + " bytes (scene " + std::to_string(plan.scene) + ", textures " +
+                        std::to_string(plan.textures) + " for " + std::to_string(plan.texels) + " texels in " +
+                        std::to_string(plan.images) + " images, drawing " + std::to_string(plan.pipeline) + ", image " +
                         std::to_string(plan.image) + "), more than the " + std::to_string(budget) +
                         " bytes allowed (half the physical memory)");
 

@@ -532,7 +532,9 @@ bool image_dimensions(const ImageSource& src, int& width, int& height, int* byte
     if (bytes->empty() || bytes->size() > std::size_t(INT_MAX)) return false;
     const stbi_uc* data = bytes->data();
     const int len = int(bytes->size());
-    if (!stb_unsafe(data, bytes->size()).empty()) return false;  // stbi_info reads the tables too
+    // stbi_info reads a JPEG's tables (guarded); a Radiance header alone is
+    // safe, and its pixels are beyond the prefix read here.
+    if (!looks_like_hdr(data, bytes->size()) && !stb_unsafe(data, bytes->size()).empty()) return false;
     int comp = 0;
     if (!stbi_info_from_memory(data, len, &width, &height, &comp)) return false;
     if (bytes_per_texel)

@@ -299,6 +299,35 @@ TEST_CASE("OBJ/MTL references that leave the model's folder are refused; --allow
     CHECK(has_line_with(r.err, "material library '../evil.mtl' refused: climbs out of the model's folder"));
 }
 
+TEST_CASE("the library: LoadOptions and FileScope apply the same rule") {
+    test::TempDir dir("hostile_lib");
+    fs::create_directories(dir.path / "m");
+    write_png(dir.file("out.png"), 2, 2, 1, 2, 3);
+    write_png(dir.file("m/in.png"), 2, 2, 1, 2, 3);
+    test::write_text(dir.file("m/m.mtl"), "newmtl a\nmap_Kd ../out.png\nnewmtl b\nmap_Kd in.png\nmap_Ke ./in.png\n");
+    test::write_text(dir.file("m/m.obj"), std::string(kTriangleObj) + "usemtl b\nf 3 2 1\n");
+    const Scene confined = load_obj(dir.file("m/m.obj"));
+    REQUIRE(confined.images.size() == 1);  // in.png once, however spelled
+    CHECK(confined.images[0].path == fs::canonical(dir.path / "m" / "in.png").string());
+    REQUIRE(confined.warnings.size() == 1);
+    CHECK(confined.warnings[0].find("map_Kd '../out.png' refused: climbs out of the model's folder") !=
+          std::string::npos);
+    LoadOptions allow;
+    allow.allow_outside_paths = true;
+    const Scene open = load_obj(dir.file("m/m.obj"), allow);
+    CHECK(open.images.size() == 2);
+    CHECK(open.warnings.empty());
+
+    FileScope scope(dir.file("m/m.obj"), false);
+    CHECK(scope.root() == fs::canonical(dir.path / "m").string());
+    CHECK(scope.resolve(scope.root(), "in.png").ok());
+    CHECK(scope.resolve(scope.root(), "nope.png").missing);
+    const FileScope::Resolved out = scope.resolve(scope.root(), "..\\out.png");
+    CHECK(!out.ok());
+    CHECK(out.outside);
+    CHECK(scope.resolve(scope.root(), std::string("in.png\0x", 8)).refused == "the name holds a NUL byte");
+}
+
 TEST_CASE("glTF buffer and image uris stay in the model's folder, percent-encoded or not, and never in the current directory") {
     CliSandbox box;
     fs::create_directories(box.work() / "model");
@@ -693,6 +722,53 @@ TEST_CASE("running out of memory inside a pool task is one line, not terminate")
     CHECK(r.code == 1);
     CHECK(r.err == "render: out of memory while rendering frame 0 (try a smaller --size or a smaller scene)\n");
     CHECK(box.work_files() == std::vector<std::string>{"cover.obj"});
+}
+
+TEST_CASE("a render whose textures cannot fit in memory is refused before anything is decoded") {
+    // 16384 x 8192 Radiance files (2^27 texels; stb_image decodes no more
+    // than 2 GB of floats): 2.9 GB each decoded with mips, twice when used as
+    // colour and as data. Enough hard links to one 8 MB file pass half the
+    // physical memory.
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    REQUIRE(pages > 0);
+    const double budget = double(pages) * double(page) / 2.0;
+    const double per_file = 2.0 * double(std::int64_t(1) << 27) * 16.0 * 4.0 / 3.0;
+    const int files = int(budget / per_file) + 1;
+    if (files > 64) {
+        MESSAGE("skipped: this machine has so much memory that " << files << " huge textures would be needed");
+        return;
+    }
+    CliSandbox box;
+    constexpr int kWidth = 16384, kHeight = 8192;
+    std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(kHeight) + " +X " +
+                      std::to_string(kWidth) + "\n";
+    std::string line = {2, 2, char(kWidth >> 8), char(kWidth & 0xFF)};
+    for (unsigned char value : {128, 64, 32, 129})
+        for (int left = kWidth; left > 0; left -= 127) {
+            line += char(128 + std::min(left, 127));
+            line += char(value);
+        }
+    for (int y = 0; y < kHeight; ++y) hdr += line;
+    write_text(box.path("h0.hdr"), hdr);
+    hdr = {};
+    std::string mtl, obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n";
+    for (int i = 0; i < files; ++i) {
+        const std::string name = "h" + std::to_string(i) + ".hdr";
+        if (i > 0) fs::create_hard_link(box.work() / "h0.hdr", box.work() / name);
+        mtl += "newmtl m" + std::to_string(i) + "\nmap_Kd " + name + "\nmap_Pr " + name + "\n";
+        obj += "usemtl m" + std::to_string(i) + "\nf 1/1 2/2 3/3\n";
+    }
+    write_text(box.path("m.mtl"), mtl);
+    write_text(box.path("m.obj"), obj);
+    const CliRun r = render(box, {"m.obj", "--size", "16x16", "-o", "o.png"});
+    CHECK(r.code == 1);
+    CHECK(lines_of(r.err).size() == 1);
+    CHECK(r.err.find("render: m.obj: the render needs about ") == 0);
+    CHECK(r.err.find(" for " + std::to_string(std::int64_t(2 * files) << 27) + " texels in " + std::to_string(files) +
+                     " images, ") !=
+          std::string::npos);
+    CHECK(r.err.find("bytes allowed (half the physical memory)") != std::string::npos);
+    CHECK(!fs::exists(box.path("o.png")));
 }
 
 // ---------------------------------------------------------------- output
