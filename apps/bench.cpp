@@ -3,7 +3,9 @@
 // tests.
 //
 //   bench [--workload quad,grid,bottle,tea,bunny,builtin] [--threads 1,2] [--repeat N] [--json]
-//   bench SCENE [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME] [--flat]
+//   bench [SCENE] [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME] [--flat]
+//                                        (any scene, the built-in one by default; --tiles, --view
+//                                        or --flat without SCENE also select this mode)
 //   bench --write-workloads DIR          the synthetic workloads as files, plus DIR/commands.txt
 //   bench --side-by-side RENDER_A RENDER_B [--workload ...] [--runs N] [--repeat N]
 //   bench --psnr A.png B.png
@@ -686,7 +688,7 @@ int main(int argc, char** argv) {
     std::vector<int> threads = {2}, tiles = {kDefaultTileSize};
     std::vector<std::string> names;
     DebugView view = DebugView::None;
-    bool flat = false, json = false, threads_given = false;
+    bool flat = false, json = false, threads_given = false, tiles_given = false;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -695,7 +697,7 @@ int main(int argc, char** argv) {
                 width > kMaxViewportSize || height > kMaxViewportSize)
                 return usage();
         } else if (a == "--threads") { threads = parse_list(next()); threads_given = true; }
-        else if (a == "--tiles") tiles = parse_list(next());
+        else if (a == "--tiles") { tiles = parse_list(next()); tiles_given = true; }
         else if (a == "--repeat") repeat = std::max(1, std::atoi(next().c_str()));
         else if (a == "--runs") runs = std::max(1, std::atoi(next().c_str()));
         else if (a == "--view") { if (!parse_debug_view(next(), view)) return usage(); }
@@ -712,7 +714,8 @@ int main(int argc, char** argv) {
     }
     try {
         if (!psnr_a.empty()) return psnr(psnr_a, psnr_b);
-        if (!scene_path.empty() || flat || view != DebugView::None)
+        // A scene, a tile sweep, a debug view or the flat program: the scene mode.
+        if (!scene_path.empty() || flat || tiles_given || view != DebugView::None)
             return bench_scene(scene_path, width, height, threads_given ? threads : std::vector<int>{1, 2}, tiles,
                                repeat, view, flat);
         if (!write_dir.empty()) {

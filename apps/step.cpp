@@ -41,7 +41,8 @@ const char* step_usage() {
 "  scene, camera, light and view flags as render's (render --help):\n"
 "  --size WxH --eye X,Y,Z --target X,Y,Z --up X,Y,Z --fov DEG --near N --far F\n"
 "  --sun X,Y,Z:R,G,B --point X,Y,Z:R,G,B --ambient R,G,B --no-default-lights\n"
-"  --brdf default|gltf --exposure E --tonemap none|aces|neutral --threads N --tile N\n"
+"  --brdf default|gltf --exposure E --tonemap none|aces|neutral --msaa N\n"
+"  --threads N --tile N\n"
 "  --help, --version    exit codes: 0 ok, 1 bad file or a failed command, 2 bad usage\n";
 }
 
@@ -139,6 +140,7 @@ int run(int argc, char** argv) {
     req.tonemap = opt.effective_tonemap();
     req.threads = opt.threads;
     req.tile_size = opt.tile_size;
+    req.samples = opt.msaa;
 
     StepScene scene;
     SetupError setup_err;

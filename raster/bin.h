@@ -1,13 +1,18 @@
 // Binning: every set-up triangle is listed in each screen tile its edges reach.
-// A binning job owns a contiguous range of triangles and writes its own bins
-// (CSR: per-tile offsets into one item array), so concatenating the jobs' bins
-// in job order gives each tile its triangles in submission order, whatever the
-// thread count.
+// A binning job owns a contiguous range of one draw's triangles and writes its
+// own bins (CSR: per-tile offsets into one item array), so walking the jobs of
+// a frame in order (draw by draw, job by job) gives each tile its triangles in
+// submission order, whatever the thread count. bin_triangles() is the whole
+// per-job stage: assemble, clip, cull, set up, bin.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include "raster/clip.h"
+#include "raster/observer.h"
+#include "raster/samples.h"
 #include "raster/setup.h"
 #include "raster/stats.h"
 
@@ -41,22 +46,28 @@ struct BinJob {
 };
 
 // Appends the tiles that triangle `index` of `job` touches to job.pairs
-// (tiles whose every pixel centre is outside one edge are skipped).
+// (tiles whose every sample is outside one edge are skipped).
 template <class OnBin>
-inline void bin_triangle(BinJob& job, std::uint32_t index, const TileGrid& grid, OnBin&& on_bin) {
+inline void bin_triangle(BinJob& job, std::uint32_t index, const TileGrid& grid, const SampleExtent& samples,
+                         OnBin&& on_bin) {
     const TriangleSetup& t = job.setups[index];
     int tx0 = t.minx / grid.tile_size, tx1 = t.maxx / grid.tile_size;
     int ty0 = t.miny / grid.tile_size, ty1 = t.maxy / grid.tile_size;
-    bool single = tx0 == tx1 && ty0 == ty1;
+    if (tx0 == tx1 && ty0 == ty1) {
+        const std::uint32_t tile = std::uint32_t(ty0 * grid.tiles_x + tx0);
+        job.pairs.push_back((std::uint64_t(tile) << 32) | index);
+        on_bin(tile);
+        return;
+    }
+    const EdgeSpan span[3] = {edge_span(t, 0, grid.tile_size, samples), edge_span(t, 1, grid.tile_size, samples),
+                              edge_span(t, 2, grid.tile_size, samples)};
     for (int ty = ty0; ty <= ty1; ++ty)
         for (int tx = tx0; tx <= tx1; ++tx) {
-            if (!single) {
-                int x = tx * grid.tile_size, y = ty * grid.tile_size;
-                if (classify_block(t, 0, x, y, grid.tile_size) == kEdgeOut ||
-                    classify_block(t, 1, x, y, grid.tile_size) == kEdgeOut ||
-                    classify_block(t, 2, x, y, grid.tile_size) == kEdgeOut)
-                    continue;
-            }
+            int x = tx * grid.tile_size, y = ty * grid.tile_size;
+            if (classify_edge(edge_at_pixel(t, 0, x, y), span[0]) == kEdgeOut ||
+                classify_edge(edge_at_pixel(t, 1, x, y), span[1]) == kEdgeOut ||
+                classify_edge(edge_at_pixel(t, 2, x, y), span[2]) == kEdgeOut)
+                continue;
             std::uint32_t tile = std::uint32_t(ty * grid.tiles_x + tx);
             job.pairs.push_back((std::uint64_t(tile) << 32) | index);
             on_bin(tile);
@@ -66,5 +77,104 @@ inline void bin_triangle(BinJob& job, std::uint32_t index, const TileGrid& grid,
 // Groups job.pairs by tile into tile_offsets/items, keeping submission order
 // inside each tile (a stable counting sort).
 void sort_bins(BinJob& job, int tile_count);
+
+// Assembles triangles [tri_begin, tri_end) of a draw from its post-vertex
+// array (`stride` floats per vertex), drops invalid ones, culls, clips, sets
+// up and bins them into `job`, counting each submitted triangle once.
+template <class Observer>
+void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, const std::uint32_t* indices,
+                   const float* vertices, std::uint32_t vertex_count, int stride, const TileGrid& grid,
+                   const SampleExtent& samples, bool cull_back, Observer& obs) {
+    const GuardBand gb = GuardBand::for_viewport(grid.width, grid.height);
+    float polygon[kMaxClippedVertices * (4 + kMaxVaryings)];
+    FrameStats& st = job.stats;
+
+    // Sets up one (piece of a) triangle and bins it. Counting is left to the
+    // caller, so that a clipped triangle counts once however many pieces it has.
+    auto emit = [&](const float* const clip[3], const std::uint32_t ref[3], std::uint32_t prim,
+                    bool clipped) -> SetupResult {
+        TriangleSetup t;
+        SetupResult r = setup_triangle(clip, ref, grid.width, grid.height, cull_back, t, samples);
+        if (r == SetupResult::CulledBack) {
+            if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::CulledBack, clipped, nullptr);
+            return r;
+        }
+        if (r == SetupResult::Degenerate) {
+            if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::Degenerate, clipped, nullptr);
+            return r;
+        }
+        t.prim_id = prim;
+        std::uint32_t index = std::uint32_t(job.setups.size());
+        job.setups.push_back(t);
+        ++st.triangles_setup;
+        if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::SetUp, clipped, &job.setups.back());
+        bin_triangle(job, index, grid, samples, [&](std::uint32_t tile) {
+            if constexpr (Observer::enabled) obs.binned(prim, int(tile));
+            (void)tile;
+        });
+        return r;
+    };
+    auto count = [&](bool any_setup, bool any_back) {
+        if (any_back) ++st.triangles_culled_back;
+        else if (!any_setup) ++st.triangles_degenerate;
+    };
+
+    for (std::size_t tri = tri_begin; tri < tri_end; ++tri) {
+        const std::uint32_t prim = std::uint32_t(tri);
+        ++st.triangles_in;
+        std::uint32_t ref[3] = {indices[3 * tri], indices[3 * tri + 1], indices[3 * tri + 2]};
+        // Assemble; drop triangles with bad indices or non-finite positions.
+        bool valid = ref[0] < vertex_count && ref[1] < vertex_count && ref[2] < vertex_count;
+        const float* clip[3] = {nullptr, nullptr, nullptr};
+        if (valid) {
+            for (int i = 0; i < 3; ++i) {
+                clip[i] = &vertices[std::size_t(ref[i]) * stride];
+                for (int c = 0; c < 4; ++c) valid &= std::isfinite(clip[i][c]);
+            }
+        }
+        if (!valid) {
+            ++st.triangles_invalid;
+            if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::Invalid, false, nullptr);
+            continue;
+        }
+        std::uint32_t oc0 = outcode(clip[0], gb), oc1 = outcode(clip[1], gb), oc2 = outcode(clip[2], gb);
+        if (oc0 & oc1 & oc2 & kFrustumBits) {
+            ++st.triangles_culled_frustum;
+            if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::CulledFrustum, false, nullptr);
+            continue;
+        }
+        std::uint32_t planes = (oc0 | oc1 | oc2) & kClipNeededBits;
+        if (!planes) {
+            SetupResult r = emit(clip, ref, prim, false);
+            count(r == SetupResult::Ok, r == SetupResult::CulledBack);
+            continue;
+        }
+        // Clip; the polygon's vertices go to this job's pool and the pieces are a fan.
+        ++st.triangles_clipped;
+        int n = clip_triangle(clip, stride, planes, gb, polygon);
+        bool positive_w = n >= 3;
+        for (int i = 0; i < n; ++i) positive_w &= polygon[i * stride + 3] > 0.0f;
+        if (!positive_w) {
+            ++st.triangles_culled_frustum;
+            if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::CulledFrustum, true, nullptr);
+            continue;
+        }
+        std::uint32_t base = std::uint32_t(job.clip_pool.size() / stride);
+        job.clip_pool.insert(job.clip_pool.end(), polygon, polygon + n * stride);
+        bool any_setup = false, any_back = false;
+        for (int i = 1; i + 1 < n; ++i) {
+            std::uint32_t pref[3] = {(base | kClippedVertexBit), ((base + i) | kClippedVertexBit),
+                                     ((base + i + 1) | kClippedVertexBit)};
+            // Pool pointers are taken after the insert, so they stay valid.
+            const float* pclip[3] = {&job.clip_pool[std::size_t(base) * stride],
+                                     &job.clip_pool[std::size_t(base + i) * stride],
+                                     &job.clip_pool[std::size_t(base + i + 1) * stride]};
+            SetupResult r = emit(pclip, pref, prim, true);
+            any_setup |= r == SetupResult::Ok;
+            any_back |= r == SetupResult::CulledBack;
+        }
+        count(any_setup, any_back);
+    }
+}
 
 } // namespace prast

@@ -5,6 +5,10 @@
 // which keeps each quad's four lanes adjacent for screen-space derivatives.
 // Lanes outside the triangle (helper lanes) still carry extrapolated varyings,
 // so derivatives are valid for every quad that has at least one live lane.
+// Multisampling: a live lane whose pixel centre is outside the triangle is
+// interpolated at the centroid of its covered samples instead (so textures do
+// not bleed from beyond the edge); derivatives still come from the centre
+// values, so they, and the pixels whose centres are inside, are unchanged.
 #pragma once
 
 #include <cstdint>
@@ -25,12 +29,29 @@ struct FragmentBlock {
     std::uint32_t mask = 0;    // live lanes: covered and passed the depth test
     std::uint32_t prim_id = 0; // index of the submitted triangle in the draw
     bool front_facing = true;
+    // Lanes interpolated at a centroid (multisampling); when non-zero,
+    // centre_var holds every lane's values at its pixel centre.
+    std::uint32_t centroid_mask = 0;
+    alignas(64) float centre_var[NV > 0 ? NV : 1][kBlockLanes];
 
     bool quad_live(int quad) const { return (mask >> (quad * 4)) & 0xFu; }
     // Coarse derivatives, one per quad (the OpenGL spec allows it): x from the
-    // top row of the quad, y from its left column.
-    float ddx(int k, int lane) const { int q = lane & ~3; return var[k][q + 1] - var[k][q]; }
-    float ddy(int k, int lane) const { int q = lane & ~3; return var[k][q + 2] - var[k][q]; }
+    // top row of the quad, y from its left column, at the pixel centres.
+    // (centre_var is only read when centroid_mask says it was written, which
+    // GCC cannot see through the rasterizer's calls.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+    float ddx(int k, int lane) const {
+        const int q = lane & ~3;
+        if (centroid_mask) return centre_var[k][q + 1] - centre_var[k][q];
+        return var[k][q + 1] - var[k][q];
+    }
+    float ddy(int k, int lane) const {
+        const int q = lane & ~3;
+        if (centroid_mask) return centre_var[k][q + 2] - centre_var[k][q];
+        return var[k][q + 2] - var[k][q];
+    }
+#pragma GCC diagnostic pop
 };
 
 struct FragmentOut {

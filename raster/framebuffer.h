@@ -1,5 +1,8 @@
 // The render target: linear float RGBA colour and float depth, row-major, row 0
 // at the top. Depth is 32-bit float window z in [0, 1], cleared to 1, test LESS.
+// A depth target (shadow maps) has no colour: depth_only(w, h), color empty.
+// A multisampled frame keeps its samples in tile-local buffers and leaves here
+// the resolved colour and each pixel's nearest sample depth (README "Anti-aliasing").
 #pragma once
 
 #include <algorithm>
@@ -10,11 +13,21 @@ namespace prast {
 
 struct Framebuffer {
     int width = 0, height = 0;
-    std::vector<float> color;  // 4 floats per pixel
+    std::vector<float> color;  // 4 floats per pixel; empty for a depth target
     std::vector<float> depth;  // 1 float per pixel
 
     Framebuffer() = default;
     Framebuffer(int w, int h) { resize(w, h); }
+
+    static Framebuffer depth_only(int w, int h) {
+        Framebuffer fb;
+        fb.width = w;
+        fb.height = h;
+        fb.depth.assign(std::size_t(w) * h, 1.0f);
+        return fb;
+    }
+
+    bool has_color() const { return !color.empty(); }
 
     void resize(int w, int h) {
         width = w;

@@ -42,6 +42,10 @@ constexpr int kMaxTileSize = 256;
 // Varyings per vertex, a compile-time constant of each program.
 constexpr int kMaxVaryings = 32;
 
+// Samples per pixel (multisampling): 1, 2, 4 or 8, the counts with standard
+// positions (samples.h). A lane's per-sample masks fit in a byte.
+constexpr int kMaxSamples = 8;
+
 // Binning jobs: triangles are set up and binned in chunks of this many, so the
 // per-tile bins stay in submission order whatever the thread count.
 constexpr int kTrianglesPerJob = 2048;

@@ -1,8 +1,9 @@
-// Tile rasterization: for one screen tile, walk its bins in submission order and
-// for each triangle reject or accept 16x16 blocks, then 4x4 blocks, then pixels
-// (exact integer edge tests), run the early depth test, interpolate varyings
-// perspective-correctly and call the fragment shader once per 4x4 block.
-// One thread owns a tile at a time, so colour and depth need no locking.
+// Rasterization of one triangle inside one tile: reject or accept 16x16
+// blocks, then 4x4 blocks, then samples (exact integer edge tests at every
+// sample position), then each covered sample's depth and the LESS test. This
+// file owns coverage and depth; shade.h runs the fragment program on what
+// survives, and frame.h walks a tile's bins in submission order. One thread
+// owns a tile at a time, so its colour, depth and winners need no locking.
 #pragma once
 
 #include <algorithm>
@@ -13,25 +14,52 @@
 #include <immintrin.h>
 #endif
 
-#include "raster/bin.h"
-#include "raster/draw_state.h"
 #include "raster/fragment.h"
-#include "raster/framebuffer.h"
 #include "raster/observer.h"
+#include "raster/samples.h"
 #include "raster/setup.h"
 #include "raster/stats.h"
 
 namespace prast {
 
-// Everything a tile needs from its draw call.
+// A sample whose colour is final in the target (cleared, or written by a draw
+// shaded in order) rather than owed by a winner of the visibility pass.
+constexpr std::uint32_t kNoWinner = 0xFFFFFFFFu;
+
+// Where the samples of one tile live. With one sample, colour and depth are
+// the framebuffer itself (row = its width, origin 0, 0); with several, the
+// tile-local planes of frame.h (row = tile size, origin = the tile's corner,
+// sample s at s * plane). Winners are always tile-local.
+struct TileTarget {
+    float* color = nullptr;          // RGBA per sample; null for a depth target
+    float* depth = nullptr;
+    std::size_t row = 0, plane = 0;  // in pixels
+    int ox = 0, oy = 0;
+    bool local = false;              // tile-local planes: every 4x4 block of the tile lies inside them
+    std::uint32_t* winner = nullptr;
+    std::size_t wrow = 0, wplane = 0;
+    int wox = 0, woy = 0;
+
+    std::size_t offset(int x, int y) const { return std::size_t(y - oy) * row + std::size_t(x - ox); }
+    std::size_t winner_offset(int x, int y) const { return std::size_t(y - woy) * wrow + std::size_t(x - wox); }
+};
+
+// What a tile's triangles share: the viewport, the samples and the target.
 struct TileContext {
-    Framebuffer* fb;
-    const TileGrid* grid;
-    const DrawState* state;
-    const float* vertices;       // post-vertex-shader array
-    const BinJob* jobs;
-    int job_count;
-    int stride;                  // floats per vertex: 4 + varyings
+    int width = 0, height = 0;         // viewport
+    const SamplePattern* samples = nullptr;
+    SampleExtent extent;
+    TileTarget target;
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the tile's pixels, inclusive
+    FrameStats* stats = nullptr;
+    std::uint64_t* dirty = nullptr;    // a bit per 4x4 block of the tile holding winners
+    int blocks_x = 0;                  // 4x4 blocks per tile row
+
+    int sample_count() const { return samples->count; }
+    void mark_dirty(int bx, int by) {
+        const int b = ((by - y0) / kBlockSize) * blocks_x + (bx - x0) / kBlockSize;
+        dirty[b >> 6] |= std::uint64_t(1) << (b & 63);
+    }
 };
 
 namespace detail {
@@ -47,73 +75,50 @@ inline std::uint32_t scissor_mask(int bx, int by, int width, int height) {
     return m;
 }
 
-// Per-triangle data prepared once per tile: lane offsets of the edge functions,
-// the extremes of each edge function over a 16x16 and a 4x4 block relative to
-// its top-left pixel (classify_block() of setup.h, whose terms do not depend on
-// the block), and the varyings of the three vertices as (v0, v1 - v0, v2 - v0).
-template <int NV>
+// Per-triangle data prepared once per tile: lane offsets of the edge
+// functions, each edge's extremes over a 16x16 and a 4x4 block relative to its
+// top-left pixel centre (edge_span of setup.h, over the samples), and each
+// sample's offset of each edge function from the pixel centre.
 struct TriangleInTile {
     std::int64_t lane_offset[3][kBlockLanes];
-    std::int64_t coarse_hi[3], coarse_lo[3], fine_hi[3], fine_lo[3];
-    float v0[NV > 0 ? NV : 1], d1[NV > 0 ? NV : 1], d2[NV > 0 ? NV : 1];
+    EdgeSpan coarse[3], fine[3];
+    std::int64_t sample_offset[3][kMaxSamples];
 };
 
-// classify_block(t, e, x, y, size) with the block-independent terms taken
-// from TriangleInTile: the same integer sums, hence the same answer.
-inline EdgeClass classify_edge(std::int64_t e0, std::int64_t hi, std::int64_t lo) {
-    if (e0 + hi < 0) return kEdgeOut;
-    if (e0 + lo >= 0) return kEdgeIn;
-    return kEdgePartial;
+// A x + B y at the lanes' pixel offsets (fragment.h's lane order), by exact
+// integer sums: quad (qx, qy) adds 2 qx A + 2 qy B to quad 0.
+inline void lane_offsets(std::int64_t a, std::int64_t b, std::int64_t* out) {
+    typedef std::int64_t Int64x4 __attribute__((vector_size(32)));
+    const std::int64_t a1 = a * kSubPixelScale, b1 = b * kSubPixelScale;
+    const Int64x4 quad0 = {0, a1, b1, a1 + b1};
+    const Int64x4 quad1 = quad0 + 2 * a1, quad2 = quad0 + 2 * b1, quad3 = quad1 + 2 * b1;
+    std::memcpy(out + 0, &quad0, sizeof quad0);
+    std::memcpy(out + 4, &quad1, sizeof quad1);
+    std::memcpy(out + 8, &quad2, sizeof quad2);
+    std::memcpy(out + 12, &quad3, sizeof quad3);
 }
 
-template <int NV>
-void prepare_triangle(const TriangleSetup& t, const TileContext& ctx, const BinJob& job,
-                      TriangleInTile<NV>& p) {
+template <bool MS>
+inline void prepare_coverage(const TriangleSetup& t, const TileContext& c, TriangleInTile& p) {
     for (int e = 0; e < 3; ++e) {
-        // A x + B y at the lanes' pixel offsets (fragment.h's lane order), by
-        // exact integer sums: quad (qx, qy) adds 2 qx A + 2 qy B to quad 0.
-        typedef std::int64_t Int64x4 __attribute__((vector_size(32)));
-        const std::int64_t a = t.A[e], b = t.B[e];
-        const std::int64_t a1 = a * kSubPixelScale, b1 = b * kSubPixelScale;
-        const Int64x4 quad0 = {0, a1, b1, a1 + b1};
-        const Int64x4 quad1 = quad0 + 2 * a1, quad2 = quad0 + 2 * b1, quad3 = quad1 + 2 * b1;
-        std::memcpy(&p.lane_offset[e][0], &quad0, sizeof quad0);
-        std::memcpy(&p.lane_offset[e][4], &quad1, sizeof quad1);
-        std::memcpy(&p.lane_offset[e][8], &quad2, sizeof quad2);
-        std::memcpy(&p.lane_offset[e][12], &quad3, sizeof quad3);
-        const std::int64_t coarse = std::int64_t(kCoarseBlockSize - 1) * kSubPixelScale;
-        const std::int64_t fine = std::int64_t(kBlockSize - 1) * kSubPixelScale;
-        p.coarse_hi[e] = (a > 0 ? a : 0) * coarse + (b > 0 ? b : 0) * coarse;
-        p.coarse_lo[e] = (a < 0 ? a : 0) * coarse + (b < 0 ? b : 0) * coarse;
-        p.fine_hi[e] = (a > 0 ? a : 0) * fine + (b > 0 ? b : 0) * fine;
-        p.fine_lo[e] = (a < 0 ? a : 0) * fine + (b < 0 ? b : 0) * fine;
+        lane_offsets(t.A[e], t.B[e], p.lane_offset[e]);
+        if constexpr (MS) {
+            const SamplePattern& sp = *c.samples;
+            p.coarse[e] = edge_span(t, e, kCoarseBlockSize, c.extent);
+            p.fine[e] = edge_span(t, e, kBlockSize, c.extent);
+            for (int s = 0; s < sp.count; ++s)
+                p.sample_offset[e][s] = std::int64_t(t.A[e]) * sp.fixed_x(s) + std::int64_t(t.B[e]) * sp.fixed_y(s);
+        } else {
+            // edge_span with the single sample at the centre.
+            const std::int64_t a = t.A[e], b = t.B[e];
+            const std::int64_t a_hi = a > 0 ? a : 0, a_lo = a < 0 ? a : 0, b_hi = b > 0 ? b : 0, b_lo = b < 0 ? b : 0;
+            constexpr std::int64_t coarse = std::int64_t(kCoarseBlockSize - 1) * kSubPixelScale;
+            constexpr std::int64_t fine = std::int64_t(kBlockSize - 1) * kSubPixelScale;
+            p.coarse[e] = {(a_hi + b_hi) * coarse, (a_lo + b_lo) * coarse};
+            p.fine[e] = {(a_hi + b_hi) * fine, (a_lo + b_lo) * fine};
+            p.sample_offset[e][0] = 0;
+        }
     }
-    const float* v[3];
-    for (int i = 0; i < 3; ++i) {
-        std::uint32_t r = t.vtx[i];
-        v[i] = (r & kClippedVertexBit) ? &job.clip_pool[std::size_t(r & ~kClippedVertexBit) * ctx.stride]
-                                       : &ctx.vertices[std::size_t(r) * ctx.stride];
-    }
-    for (int k = 0; k < NV; ++k) {
-        p.v0[k] = v[0][4 + k];
-        p.d1[k] = v[1][4 + k] - v[0][4 + k];
-        p.d2[k] = v[2][4 + k] - v[0][4 + k];
-    }
-}
-
-// Eight floats with lane-wise IEEE arithmetic (the GCC/Clang vector
-// extension), for the block loops that the auto-vectoriser gets wrong: given
-// the interpolation loop, it vectorises across varyings and transposes. Only
-// ever a local variable: as a parameter or return value by value its ABI would
-// depend on AVX (-Wpsabi).
-typedef float Lanes8 __attribute__((vector_size(32)));
-inline void load_lanes(Lanes8& v, const float* p) { std::memcpy(&v, p, sizeof v); }
-inline void store_lanes(float* p, const Lanes8& v) { std::memcpy(p, &v, sizeof v); }
-
-// Offset of lane l's pixel from the block's top-left pixel, in a row-major
-// buffer `width` pixels wide. Lanes 2j and 2j + 1 are neighbours in one row.
-inline std::size_t lane_offset_in(int width, int l) {
-    return std::size_t(lane_y(l)) * std::size_t(width) + std::size_t(lane_x(l));
 }
 
 // Lane masks from comparisons. The compiler unrolls these loops and tests
@@ -151,233 +156,304 @@ inline std::uint32_t nonnegative_mask(std::int64_t e0, const std::int64_t* offse
 #endif
 }
 
-// Depth test, interpolation, shading and write-back of one 4x4 block.
-template <class Program, class Observer>
-void shade_block(const Program& program, const TileContext& ctx, const TriangleSetup& t,
-                 const TriangleInTile<Program::kVaryings>& p, int bx, int by, std::uint32_t mask,
-                 FrameStats& stats, Observer& obs) {
-    constexpr int NV = Program::kVaryings;
-    Framebuffer& fb = *ctx.fb;
-    const DrawState& st = *ctx.state;
-    const bool full = bx + kBlockSize <= fb.width && by + kBlockSize <= fb.height;
-    const std::size_t block_offset = std::size_t(by) * std::size_t(fb.width) + std::size_t(bx);
+// Lanes whose pixel centre is inside the triangle (the one-sample coverage),
+// without a prepared TriangleInTile: for the centroid decision.
+inline std::uint32_t centre_coverage(const TriangleSetup& t, int bx, int by) {
+    std::uint32_t m = 0xFFFFu;
+    alignas(32) std::int64_t offset[kBlockLanes];
+    for (int e = 0; e < 3; ++e) {
+        lane_offsets(t.A[e], t.B[e], offset);
+        m &= nonnegative_mask(edge_at_pixel(t, e, bx, by), offset);
+    }
+    return m;
+}
 
-    // Screen-space barycentrics from the anchored planes, then depth.
-    alignas(64) float b0[kBlockLanes], b1[kBlockLanes], b2[kBlockLanes];
-    FragmentBlock<NV> in;
-    const float ox = float(bx - t.minx), oy = float(by - t.miny);
+// Offset of lane l's pixel from the block's top-left pixel, in a row-major
+// buffer `row` pixels wide. Lanes 2j and 2j + 1 are neighbours in one row.
+inline std::size_t lane_offset_in(std::size_t row, int l) {
+    return std::size_t(lane_y(l)) * row + std::size_t(lane_x(l));
+}
+
+#if defined(__AVX2__)
+// Half a block (lanes h..h+7, h = 0 or 8) is two block rows: lanes 0,1,4,5
+// then 2,3,6,7 of the half. This permutation turns lane order into row order
+// and back (it is its own inverse); kRowSelect[i] is the lane bit of row
+// position i, so a broadcast mask ANDed with it gives row-ordered lane masks.
+inline __m256i half_row_order() { return _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7); }
+inline __m256i half_row_mask(std::uint32_t mask_bits) {
+    const __m256i select = _mm256_setr_epi32(1, 2, 16, 32, 4, 8, 64, 128);
+    return _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int(mask_bits & 0xFFu)), select), select);
+}
+#endif
+
+// The 16 values of a block in lane order from a row-major buffer; lanes
+// outside `mask` read 0 unless the whole block is inside the buffer (`full`).
+// Masked-out lanes are never touched (the block may straddle the buffer's end).
+inline void load_block(const float* p, std::size_t row, bool full, std::uint32_t mask, float* out) {
+#if defined(__AVX2__)
+    const std::uint32_t m = full ? 0xFFFFu : mask;
+    for (int h = 0; h < kBlockLanes; h += 8, p += 2 * row) {
+        if (!((m >> h) & 0xFFu)) {
+            _mm256_storeu_ps(out + h, _mm256_setzero_ps());
+            continue;
+        }
+        const __m256i mm = half_row_mask(m >> h);
+        const __m128 r0 = _mm_maskload_ps(p, _mm256_castsi256_si128(mm));
+        const __m128 r1 = _mm_maskload_ps(p + row, _mm256_extracti128_si256(mm, 1));
+        _mm256_storeu_ps(out + h, _mm256_permutevar8x32_ps(_mm256_set_m128(r1, r0), half_row_order()));
+    }
+#else
+    if (full) {
+        for (int l = 0; l < kBlockLanes; l += 2) std::memcpy(&out[l], p + lane_offset_in(row, l), 2 * sizeof(float));
+    } else {
+        for (int l = 0; l < kBlockLanes; ++l) out[l] = (mask & (1u << l)) ? p[lane_offset_in(row, l)] : 0.0f;
+    }
+#endif
+}
+
+inline void store_block(float* p, std::size_t row, std::uint32_t mask, const float* v) {
+#if defined(__AVX2__)
+    for (int h = 0; h < kBlockLanes; h += 8, p += 2 * row) {
+        if (!((mask >> h) & 0xFFu)) continue;
+        const __m256i mm = half_row_mask(mask >> h);
+        const __m256 r = _mm256_permutevar8x32_ps(_mm256_loadu_ps(v + h), half_row_order());
+        _mm_maskstore_ps(p, _mm256_castsi256_si128(mm), _mm256_castps256_ps128(r));
+        _mm_maskstore_ps(p + row, _mm256_extracti128_si256(mm, 1), _mm256_extractf128_ps(r, 1));
+    }
+#else
+    for (std::uint32_t m = mask; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        p[lane_offset_in(row, l)] = v[l];
+    }
+#endif
+}
+
+inline void store_winner(std::uint32_t* p, std::size_t row, std::uint32_t mask, std::uint32_t id) {
+#if defined(__AVX2__)
+    const __m128i v = _mm_set1_epi32(int(id));
+    for (int h = 0; h < kBlockLanes; h += 8, p += 2 * row) {
+        if (!((mask >> h) & 0xFFu)) continue;
+        const __m256i mm = half_row_mask(mask >> h);
+        _mm_maskstore_epi32(reinterpret_cast<int*>(p), _mm256_castsi256_si128(mm), v);
+        _mm_maskstore_epi32(reinterpret_cast<int*>(p + row), _mm256_extracti128_si256(mm, 1), v);
+    }
+#else
+    for (std::uint32_t m = mask; m; m &= m - 1) p[lane_offset_in(row, __builtin_ctz(m))] = id;
+#endif
+}
+
+// The 16 winners of a block in lane order (tile-local: the block is inside).
+inline void load_winners(const std::uint32_t* p, std::size_t row, std::uint32_t* out) {
+#if defined(__AVX2__)
+    for (int h = 0; h < kBlockLanes; h += 8, p += 2 * row) {
+        const __m128i r0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+        const __m128i r1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + row));
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + h),
+                            _mm256_permutevar8x32_epi32(_mm256_set_m128i(r1, r0), half_row_order()));
+    }
+#else
+    for (int l = 0; l < kBlockLanes; l += 2)
+        std::memcpy(&out[l], p + lane_offset_in(row, l), 2 * sizeof(std::uint32_t));
+#endif
+}
+
+// Screen-space barycentrics of the 16 lanes from the anchored planes, at the
+// pixel centres moved by (sx, sy) pixels (a sample's offset; kOffset false:
+// the centres themselves, with exactly the one-sample float operations).
+template <bool kOffset>
+inline void block_barycentrics(const TriangleSetup& t, int bx, int by, float sx, float sy, float* b0, float* b1,
+                               float* b2) {
+    const float ox = float(bx - t.ax), oy = float(by - t.ay);
     for (int l = 0; l < kBlockLanes; ++l) {
         float dx = ox + float(lane_x(l)), dy = oy + float(lane_y(l));
+        if constexpr (kOffset) {
+            dx = dx + sx;
+            dy = dy + sy;
+        }
         b0[l] = t.bary[0][0] + t.bary[0][1] * dx + t.bary[0][2] * dy;
         b1[l] = t.bary[1][0] + t.bary[1][1] * dx + t.bary[1][2] * dy;
         b2[l] = t.bary[2][0] + t.bary[2][1] * dx + t.bary[2][2] * dy;
-        float z = b0[l] * t.z[0] + b1[l] * t.z[1] + b2[l] * t.z[2];
-        in.z[l] = std::min(std::max(z, 0.0f), 1.0f);
     }
+}
 
-    // Early depth test (the shader never writes depth): the buffer's depths in
-    // lane order, then one vector compare.
-    std::uint32_t pass = mask;
-    if (st.depth_test) {
-        alignas(64) float d[kBlockLanes];
-        const float* depth = &fb.depth[block_offset];
-        if (full) {
-            for (int l = 0; l < kBlockLanes; l += 2)
-                std::memcpy(&d[l], depth + lane_offset_in(fb.width, l), 2 * sizeof(float));
+inline float depth_from_barycentrics(const TriangleSetup& t, float b0, float b1, float b2) {
+    const float z = b0 * t.z[0] + b1 * t.z[1] + b2 * t.z[2];
+    return std::min(std::max(z, 0.0f), 1.0f);
+}
+
+// Window depth of the 16 lanes at sample s (linear in screen space).
+inline void sample_depths(const TriangleSetup& t, const SamplePattern& sp, int s, int bx, int by, float* z) {
+    alignas(64) float b0[kBlockLanes], b1[kBlockLanes], b2[kBlockLanes];
+    if (sp.count == 1) block_barycentrics<false>(t, bx, by, 0.0f, 0.0f, b0, b1, b2);
+    else block_barycentrics<true>(t, bx, by, sp.pixel_x(s), sp.pixel_y(s), b0, b1, b2);
+    for (int l = 0; l < kBlockLanes; ++l) z[l] = depth_from_barycentrics(t, b0[l], b1[l], b2[l]);
+}
+
+// One block of one triangle, sample by sample: coverage, depth, depth test.
+// With one sample the depths come from the centre barycentrics, which are
+// kept for the interpolation (b0, b1, b2).
+struct BlockSamples {
+    std::uint32_t cover[kMaxSamples];
+    std::uint32_t pass[kMaxSamples];
+    std::uint32_t any_cover = 0, any_pass = 0;
+    alignas(64) float z[kMaxSamples][kBlockLanes];
+    alignas(64) float b0[kBlockLanes], b1[kBlockLanes], b2[kBlockLanes];
+};
+
+// Samples per pixel: 1 at compile time, or the frame's count (MS).
+template <bool MS>
+inline int samples_of(const TileContext& c) { return MS ? c.sample_count() : 1; }
+
+// Depths of the covered samples and the LESS test against the target (every
+// covered sample passes without a depth test). `all_z`: also the depths of
+// samples nothing covers (for observers).
+template <bool MS>
+inline void test_depth(const TriangleSetup& t, const TileContext& c, int bx, int by, bool depth_test, bool all_z,
+                       BlockSamples& bs) {
+    const TileTarget& tg = c.target;
+    const bool full = tg.local || (bx + kBlockSize <= c.width && by + kBlockSize <= c.height);
+    const float* depth = tg.depth + tg.offset(bx, by);
+    const int S = samples_of<MS>(c);
+    bs.any_pass = 0;
+    for (int s = 0; s < S; ++s, depth += tg.plane) {
+        bs.pass[s] = 0;
+        if (!bs.cover[s] && !all_z) continue;
+        if constexpr (MS) {
+            sample_depths(t, *c.samples, s, bx, by, bs.z[s]);
         } else {
-            for (int l = 0; l < kBlockLanes; ++l)
-                d[l] = (mask & (1u << l)) ? depth[lane_offset_in(fb.width, l)] : 0.0f;
+            block_barycentrics<false>(t, bx, by, 0.0f, 0.0f, bs.b0, bs.b1, bs.b2);
+            for (int l = 0; l < kBlockLanes; ++l) bs.z[0][l] = depth_from_barycentrics(t, bs.b0[l], bs.b1[l], bs.b2[l]);
         }
-        pass &= less_mask(in.z, d);
-    }
-    stats.fragments_covered += popcount16(mask);
-    stats.fragments_depth_killed += popcount16(mask & ~pass);
-    if constexpr (Observer::enabled) obs.fragments(t.prim_id, bx, by, mask, pass, in.z);
-    if (!pass) return;
-
-    // Perspective-correct weights: screen barycentrics over w, renormalised;
-    // then every varying, eight lanes at a time.
-    for (int h = 0; h < kBlockLanes; h += 8) {
-        Lanes8 q0, q1, q2;
-        load_lanes(q0, b0 + h);
-        load_lanes(q1, b1 + h);
-        load_lanes(q2, b2 + h);
-        q0 = q0 * t.inv_w[0];
-        q1 = q1 * t.inv_w[1];
-        q2 = q2 * t.inv_w[2];
-        const Lanes8 s = 1.0f / (q0 + q1 + q2);
-        const Lanes8 w1 = q1 * s, w2 = q2 * s;
-        for (int k = 0; k < NV; ++k) {
-            const Lanes8 v = p.v0[k] + w1 * p.d1[k] + w2 * p.d2[k];
-            store_lanes(in.var[k] + h, v);
+        if (!bs.cover[s]) continue;
+        if (depth_test) {
+            alignas(64) float d[kBlockLanes];
+            load_block(depth, tg.row, full, bs.cover[s], d);
+            bs.pass[s] = bs.cover[s] & less_mask(bs.z[s], d);
+        } else {
+            bs.pass[s] = bs.cover[s];
         }
-    }
-    in.x = bx;
-    in.y = by;
-    in.mask = pass;
-    in.prim_id = t.prim_id;
-    in.front_facing = t.front_facing;
-
-    FragmentOut out;
-    out.kill = 0;
-    program.fragment(in, out);
-    std::uint32_t live = pass & ~out.kill;
-    for (int q = 0; q < 4; ++q) stats.quads_shaded += ((pass >> (4 * q)) & 0xFu) != 0;
-    stats.fragments_shader_killed += popcount16(pass & out.kill);
-    stats.fragments_written += popcount16(live);
-    if constexpr (Observer::enabled) obs.shaded(in, out, live);
-
-    // Write-back.
-    float* depth = &fb.depth[block_offset];
-    float* color = &fb.color[block_offset * 4];
-    if (st.blend == Blend::Add) {
-        for (std::uint32_t m = live; m; m &= m - 1) {
-            const int l = __builtin_ctz(m);
-            const std::size_t o = lane_offset_in(fb.width, l);
-            if (st.depth_write) depth[o] = in.z[l];
-            float* c = color + o * 4;
-            c[0] += out.r[l]; c[1] += out.g[l]; c[2] += out.b[l]; c[3] += out.a[l];
-        }
-        return;
-    }
-    if (live == 0xFFFFu) {
-        // Every pixel: lanes 2j and 2j + 1 are neighbours in a row, written
-        // as one pair of RGBA pixels.
-        if (st.depth_write)
-            for (int l = 0; l < kBlockLanes; l += 2)
-                std::memcpy(depth + lane_offset_in(fb.width, l), &in.z[l], 2 * sizeof(float));
-#if defined(__AVX2__)
-        for (int h = 0; h < kBlockLanes; h += 8) {
-            const __m256 r = _mm256_load_ps(out.r + h), g = _mm256_load_ps(out.g + h);
-            const __m256 b = _mm256_load_ps(out.b + h), a = _mm256_load_ps(out.a + h);
-            // Interleave: RGBA of lane h + i in the half of p[i % 4] given by i / 4.
-            const __m256d rg_lo = _mm256_castps_pd(_mm256_unpacklo_ps(r, g));
-            const __m256d ba_lo = _mm256_castps_pd(_mm256_unpacklo_ps(b, a));
-            const __m256d rg_hi = _mm256_castps_pd(_mm256_unpackhi_ps(r, g));
-            const __m256d ba_hi = _mm256_castps_pd(_mm256_unpackhi_ps(b, a));
-            const __m256 p0 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_lo, ba_lo));
-            const __m256 p1 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_lo, ba_lo));
-            const __m256 p2 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_hi, ba_hi));
-            const __m256 p3 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_hi, ba_hi));
-            _mm256_storeu_ps(color + lane_offset_in(fb.width, h) * 4, _mm256_permute2f128_ps(p0, p1, 0x20));
-            _mm256_storeu_ps(color + lane_offset_in(fb.width, h + 2) * 4, _mm256_permute2f128_ps(p2, p3, 0x20));
-            _mm256_storeu_ps(color + lane_offset_in(fb.width, h + 4) * 4, _mm256_permute2f128_ps(p0, p1, 0x31));
-            _mm256_storeu_ps(color + lane_offset_in(fb.width, h + 6) * 4, _mm256_permute2f128_ps(p2, p3, 0x31));
-        }
-#else
-        for (int l = 0; l < kBlockLanes; l += 2) {
-            const float pair[8] = {out.r[l], out.g[l], out.b[l], out.a[l],
-                                   out.r[l + 1], out.g[l + 1], out.b[l + 1], out.a[l + 1]};
-            std::memcpy(color + lane_offset_in(fb.width, l) * 4, pair, sizeof pair);
-        }
-#endif
-        return;
-    }
-    for (std::uint32_t m = live; m; m &= m - 1) {
-        const int l = __builtin_ctz(m);
-        const std::size_t o = lane_offset_in(fb.width, l);
-        if (st.depth_write) depth[o] = in.z[l];
-        float* c = color + o * 4;
-        c[0] = out.r[l]; c[1] = out.g[l]; c[2] = out.b[l]; c[3] = out.a[l];
+        bs.any_pass |= bs.pass[s];
     }
 }
 
-// Coverage mask of a 4x4 block for the edges not already known to be inside.
-template <int NV>
-inline std::uint32_t block_coverage(const TriangleSetup& t, const TriangleInTile<NV>& p, int bx, int by,
-                                    unsigned partial_edges) {
-    std::uint32_t mask = 0xFFFFu;
-    for (int e = 0; e < 3; ++e) {
-        if (!(partial_edges & (1u << e))) continue;
-        mask &= nonnegative_mask(edge_at_pixel(t, e, bx, by), p.lane_offset[e]);
+template <class Observer>
+inline void observe_fragments(Observer& obs, const TriangleSetup& t, const TileContext& c, int bx, int by,
+                              const BlockSamples& bs) {
+    if constexpr (Observer::enabled) {
+        obs.fragments(t.prim_id, bx, by, bs.any_cover, bs.any_pass, bs.z[0]);
+        if constexpr (observes_samples<Observer>) {
+            SampleCoverage sc;
+            sc.count = c.sample_count();
+            for (int s = 0; s < sc.count; ++s) {
+                sc.cover[s] = bs.cover[s];
+                sc.pass[s] = bs.pass[s];
+                sc.z[s] = bs.z[s];
+            }
+            obs.samples(t.prim_id, bx, by, sc);
+        }
     }
-    return mask;
+    (void)obs; (void)t; (void)c; (void)bx; (void)by; (void)bs;
 }
 
-// One triangle inside one tile.
-template <class Program, class Observer>
-void rasterize_triangle(const Program& program, const TileContext& ctx, const TriangleSetup& t,
-                        const BinJob& job, int tile_x0, int tile_y0, int tile_x1, int tile_y1,
-                        FrameStats& stats, Observer& obs) {
-    constexpr int NV = Program::kVaryings;
+inline void count_fragments(FrameStats& stats, const BlockSamples& bs) {
+    stats.fragments_covered += popcount16(bs.any_cover);
+    stats.fragments_depth_killed += popcount16(bs.any_cover & ~bs.any_pass);
+}
+
+// Calls fn(bx, by, bs) for every 4x4 block of the tile with a covered sample
+// (bs.cover and bs.any_cover filled in), hierarchically: 16x16 blocks are
+// rejected or found inside per edge, then 4x4 blocks, then samples.
+template <bool MS, class BlockFn>
+inline void for_each_block(const TriangleSetup& t, const TileContext& c, FrameStats& stats, BlockFn&& fn) {
     // The part of the tile the triangle's box overlaps (inclusive pixels).
-    int x0 = std::max(tile_x0, t.minx), x1 = std::min(tile_x1, t.maxx);
-    int y0 = std::max(tile_y0, t.miny), y1 = std::min(tile_y1, t.maxy);
+    const int x0 = std::max(c.x0, t.minx), x1 = std::min(c.x1, t.maxx);
+    const int y0 = std::max(c.y0, t.miny), y1 = std::min(c.y1, t.maxy);
     if (x0 > x1 || y0 > y1) return;
 
-    TriangleInTile<NV> p;
-    prepare_triangle<NV>(t, ctx, job, p);
-    const int W = ctx.fb->width, H = ctx.fb->height;
+    TriangleInTile p;
+    prepare_coverage<MS>(t, c, p);
+    const int S = samples_of<MS>(c);
+    BlockSamples bs;
 
-    // Iterate over 16x16 blocks: reject, or learn which edges are fully in.
     for (int cy = y0 & ~(kCoarseBlockSize - 1); cy <= y1; cy += kCoarseBlockSize) {
         for (int cx = x0 & ~(kCoarseBlockSize - 1); cx <= x1; cx += kCoarseBlockSize) {
             unsigned partial = 0;
             bool out = false;
             for (int e = 0; e < 3 && !out; ++e) {
-                EdgeClass c = classify_edge(edge_at_pixel(t, e, cx, cy), p.coarse_hi[e], p.coarse_lo[e]);
-                if (c == kEdgeOut) out = true;
-                else if (c == kEdgePartial) partial |= 1u << e;
+                EdgeClass k = classify_edge(edge_at_pixel(t, e, cx, cy), p.coarse[e]);
+                if (k == kEdgeOut) out = true;
+                else if (k == kEdgePartial) partial |= 1u << e;
             }
             if (out) continue;
-            int bx_lo = std::max(cx, x0 & ~(kBlockSize - 1)), bx_hi = std::min(cx + kCoarseBlockSize - 1, x1);
-            int by_lo = std::max(cy, y0 & ~(kBlockSize - 1)), by_hi = std::min(cy + kCoarseBlockSize - 1, y1);
+            const int bx_lo = std::max(cx, x0 & ~(kBlockSize - 1)), bx_hi = std::min(cx + kCoarseBlockSize - 1, x1);
+            const int by_lo = std::max(cy, y0 & ~(kBlockSize - 1)), by_hi = std::min(cy + kCoarseBlockSize - 1, y1);
             for (int by = by_lo; by <= by_hi; by += kBlockSize) {
                 for (int bx = bx_lo; bx <= bx_hi; bx += kBlockSize) {
-                    std::uint32_t mask;
-                    if (partial == 0) {
-                        // Iterate over fulls: every pixel centre is inside.
-                        mask = 0xFFFFu;
-                    } else {
-                        // Iterate over partials: reject 4x4 blocks, then test pixels.
-                        unsigned block_partial = 0;
+                    unsigned block_partial = 0;
+                    if (partial) {
+                        // Iterate over partials: reject 4x4 blocks, then test samples.
                         bool block_out = false;
                         for (int e = 0; e < 3 && !block_out; ++e) {
                             if (!(partial & (1u << e))) continue;
-                            EdgeClass c = classify_edge(edge_at_pixel(t, e, bx, by), p.fine_hi[e], p.fine_lo[e]);
-                            if (c == kEdgeOut) block_out = true;
-                            else if (c == kEdgePartial) block_partial |= 1u << e;
+                            EdgeClass k = classify_edge(edge_at_pixel(t, e, bx, by), p.fine[e]);
+                            if (k == kEdgeOut) block_out = true;
+                            else if (k == kEdgePartial) block_partial |= 1u << e;
                         }
                         if (block_out) continue;
-                        mask = block_partial ? block_coverage<NV>(t, p, bx, by, block_partial) : 0xFFFFu;
                     }
-                    mask &= scissor_mask(bx, by, W, H);
-                    if (!mask) continue;
+                    // Iterate over fulls: with no partial edge every sample is inside.
+                    const std::uint32_t scissor = scissor_mask(bx, by, c.width, c.height);
+                    bs.any_cover = 0;
+                    if (!block_partial) {
+                        for (int s = 0; s < S; ++s) bs.cover[s] = scissor;
+                        bs.any_cover = scissor;
+                    } else {
+                        std::int64_t e0[3];
+                        for (int e = 0; e < 3; ++e) e0[e] = edge_at_pixel(t, e, bx, by);
+                        for (int s = 0; s < S; ++s) {
+                            std::uint32_t m = scissor;
+                            for (int e = 0; e < 3; ++e)
+                                if (block_partial & (1u << e))
+                                    m &= nonnegative_mask(e0[e] + p.sample_offset[e][s], p.lane_offset[e]);
+                            bs.cover[s] = m;
+                            bs.any_cover |= m;
+                        }
+                    }
+                    if (!bs.any_cover) continue;
                     ++stats.blocks_rasterized;
-                    shade_block<Program, Observer>(program, ctx, t, p, bx, by, mask, stats, obs);
+                    fn(bx, by, bs);
                 }
             }
         }
     }
 }
 
-} // namespace detail
-
-// Runs every bin of `tile` in submission order.
-template <class Program, class Observer>
-void rasterize_tile(const Program& program, const TileContext& ctx, int tile, FrameStats& stats,
-                    Observer& obs) {
-    const TileGrid& g = *ctx.grid;
-    int tx0 = (tile % g.tiles_x) * g.tile_size, ty0 = (tile / g.tiles_x) * g.tile_size;
-    int tx1 = std::min(tx0 + g.tile_size, g.width) - 1, ty1 = std::min(ty0 + g.tile_size, g.height) - 1;
-    // The depth test reads the tile's depths first: ask for them all now, so
-    // that the cache misses overlap instead of stalling block after block.
-    const Framebuffer& fb = *ctx.fb;
-    for (int y = ty0; y <= ty1; ++y) {
-        const float* row = &fb.depth[std::size_t(y) * std::size_t(fb.width)];
-        for (int x = tx0; x <= tx1; x += 16) __builtin_prefetch(row + x);
-        __builtin_prefetch(row + tx1);
-    }
-    bool touched = false;
-    for (int j = 0; j < ctx.job_count; ++j) {
-        const BinJob& job = ctx.jobs[j];
-        std::uint32_t begin = job.tile_offsets[tile], end = job.tile_offsets[tile + 1];
-        touched |= begin != end;
-        for (std::uint32_t i = begin; i < end; ++i)
-            detail::rasterize_triangle<Program, Observer>(program, ctx, job.setups[job.items[i]], job,
-                                                          tx0, ty0, tx1, ty1, stats, obs);
-    }
-    stats.tiles_touched += touched;
+// The visibility pass for one triangle of a draw that writes depth and
+// replaces colour: depth test and write sample by sample in submission order,
+// and the triangle (`winner`, its index in the tile's list) becomes the
+// winner of every sample it passes. A draw without a fragment program (depth
+// only) passes kNoWinner and leaves the winners, hence the colour, alone.
+template <bool MS, class Observer>
+void rasterize_depth(const TriangleSetup& t, TileContext& c, bool depth_test, bool depth_write,
+                     std::uint32_t winner, Observer& obs) {
+    FrameStats& stats = *c.stats;
+    const TileTarget& tg = c.target;
+    for_each_block<MS>(t, c, stats, [&](int bx, int by, BlockSamples& bs) {
+        test_depth<MS>(t, c, bx, by, depth_test, Observer::enabled, bs);
+        count_fragments(stats, bs);
+        stats.fragments_written += popcount16(bs.any_pass);
+        observe_fragments(obs, t, c, bx, by, bs);
+        if (!bs.any_pass) return;
+        float* depth = tg.depth + tg.offset(bx, by);
+        std::uint32_t* win = tg.winner ? tg.winner + tg.winner_offset(bx, by) : nullptr;
+        for (int s = 0; s < samples_of<MS>(c); ++s, depth += tg.plane) {
+            if (!bs.pass[s]) continue;
+            if (depth_write) store_block(depth, tg.row, bs.pass[s], bs.z[s]);
+            if (winner != kNoWinner) store_winner(win + s * tg.wplane, tg.wrow, bs.pass[s], winner);
+        }
+        if (winner != kNoWinner) c.mark_dirty(bx, by);
+    });
 }
 
+} // namespace detail
 } // namespace prast

@@ -7,7 +7,8 @@
 namespace prast {
 
 SetupResult setup_triangle(const float* const clip[3], const std::uint32_t ref[3],
-                           int width, int height, bool cull_back, TriangleSetup& t) {
+                           int width, int height, bool cull_back, TriangleSetup& t,
+                           const SampleExtent& samples) {
     // Project to window space (y down, conventions.md) and snap to 1/256 pixel.
     // Double precision so that vertices far out in the guard band snap exactly.
     std::int64_t fx[3], fy[3];
@@ -51,29 +52,34 @@ SetupResult setup_triangle(const float* const clip[3], const std::uint32_t ref[3
     }
     t.front_facing = front;
 
-    // Pixel box: pixel i is a candidate when its centre i*256+128 lies within
-    // the vertices' extent. Arithmetic shifts floor negatives correctly.
+    // Pixel box: pixel i is a candidate when one of its samples i*256+128+s
+    // lies within the vertices' extent. Arithmetic shifts floor negatives
+    // correctly. The anchor is the first centre within the extent.
     std::int64_t lo_x = std::min({X[0], X[1], X[2]}), hi_x = std::max({X[0], X[1], X[2]});
     std::int64_t lo_y = std::min({Y[0], Y[1], Y[2]}), hi_y = std::max({Y[0], Y[1], Y[2]});
-    std::int64_t minx = (lo_x - kHalfPixel + kSubPixelScale - 1) >> kSubPixelBits;
-    std::int64_t maxx = (hi_x - kHalfPixel) >> kSubPixelBits;
-    std::int64_t miny = (lo_y - kHalfPixel + kSubPixelScale - 1) >> kSubPixelBits;
-    std::int64_t maxy = (hi_y - kHalfPixel) >> kSubPixelBits;
+    auto ceil_pixel = [](std::int64_t v) { return (v - kHalfPixel + kSubPixelScale - 1) >> kSubPixelBits; };
+    auto floor_pixel = [](std::int64_t v) { return (v - kHalfPixel) >> kSubPixelBits; };
+    std::int64_t minx = ceil_pixel(lo_x - samples.hi_x), maxx = floor_pixel(hi_x - samples.lo_x);
+    std::int64_t miny = ceil_pixel(lo_y - samples.hi_y), maxy = floor_pixel(hi_y - samples.lo_y);
     minx = std::max<std::int64_t>(minx, 0);
     miny = std::max<std::int64_t>(miny, 0);
     maxx = std::min<std::int64_t>(maxx, width - 1);
     maxy = std::min<std::int64_t>(maxy, height - 1);
     if (minx > maxx || miny > maxy) return SetupResult::Degenerate;
     t.minx = int(minx); t.miny = int(miny); t.maxx = int(maxx); t.maxy = int(maxy);
+    const std::int64_t ax = std::max<std::int64_t>(ceil_pixel(lo_x), 0);
+    const std::int64_t ay = std::max<std::int64_t>(ceil_pixel(lo_y), 0);
+    t.ax = int(ax); t.ay = int(ay);
 
     // Edge functions. Edge i runs from vertex i+1 to vertex i+2:
     //   E(p) = (bx - ax)(py - ay) - (by - ay)(px - ax) = A px + B py + C.
     // Top-left rule (y down, positive area): a top edge is horizontal with
     // bx > ax; a left edge goes up (by < ay). Others exclude centres exactly on
     // them, which for integers is E - 1 >= 0.
-    double anchor_x = double(minx * kSubPixelScale + kHalfPixel);
-    double anchor_y = double(miny * kSubPixelScale + kHalfPixel);
+    double anchor_x = double(ax * kSubPixelScale + kHalfPixel);
+    double anchor_y = double(ay * kSubPixelScale + kHalfPixel);
     double inv_area2 = 1.0 / double(area2);
+    t.area = float(double(area2) * (0.5 / double(kSubPixelScale * kSubPixelScale)));
     for (int e = 0; e < 3; ++e) {
         int a = (e + 1) % 3, b = (e + 2) % 3;
         std::int64_t A = Y[a] - Y[b];

@@ -23,6 +23,7 @@ void FrameStats::add_counters(const FrameStats& o) {
     fragments_depth_killed += o.fragments_depth_killed;
     fragments_shader_killed += o.fragments_shader_killed;
     fragments_written += o.fragments_written;
+    fragments_shaded += o.fragments_shaded;
     ms_vertex += o.ms_vertex;
     ms_setup_bin += o.ms_setup_bin;
     ms_raster += o.ms_raster;
@@ -48,6 +49,7 @@ std::string FrameStats::to_string() const {
         "  killed by depth      %llu\n"
         "  killed by shader     %llu\n"
         "  written              %llu\n"
+        "fragments shaded       %llu\n"
         "time vertex            %.3f ms\n"
         "time setup+bin         %.3f ms\n"
         "time raster+shade      %.3f ms\n",
@@ -59,7 +61,7 @@ std::string FrameStats::to_string() const {
         (unsigned long long)tiles_touched, (unsigned long long)blocks_rasterized,
         (unsigned long long)quads_shaded, (unsigned long long)fragments_covered,
         (unsigned long long)fragments_depth_killed, (unsigned long long)fragments_shader_killed,
-        (unsigned long long)fragments_written, ms_vertex, ms_setup_bin, ms_raster);
+        (unsigned long long)fragments_written, (unsigned long long)fragments_shaded, ms_vertex, ms_setup_bin, ms_raster);
     return buf;
 }
 

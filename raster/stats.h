@@ -21,10 +21,14 @@ struct FrameStats {
     std::uint64_t tiles_touched = 0;       // tiles with at least one bin entry
     std::uint64_t blocks_rasterized = 0;   // 4x4 blocks with coverage
     std::uint64_t quads_shaded = 0;        // 2x2 quads handed to the fragment shader with >= 1 live lane
-    std::uint64_t fragments_covered = 0;   // pixels inside triangles
-    std::uint64_t fragments_depth_killed = 0; // failed the early depth test
+    std::uint64_t fragments_covered = 0;   // pixels inside triangles (with a covered sample)
+    std::uint64_t fragments_depth_killed = 0; // failed the early depth test (every sample)
     std::uint64_t fragments_shader_killed = 0; // discarded by the shader (alpha mask)
+    // Passed the depth test and not discarded, in submission order: written at
+    // once (draws shaded in order) or the pixel's winner until a later one
+    // passes (the visibility pass); the old draw-by-draw count either way.
     std::uint64_t fragments_written = 0;
+    std::uint64_t fragments_shaded = 0;    // live lanes the fragment program ran for
     double ms_vertex = 0, ms_setup_bin = 0, ms_raster = 0;
 
     void add_counters(const FrameStats& o);

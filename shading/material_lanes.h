@@ -64,12 +64,18 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     static_assert(N % 4 == 0 && N <= kBlockLanes, "whole vectors of lanes");
     const Material& m = *bm.m;
 
-    // Look up every bound texture. Textures of one layout share their level
-    // of detail and texel indices (sample_lanes.h), prepared and read together.
+    // Look up every bound texture, the components that are used only (bit 0
+    // r .. 3 a). Textures of one layout share their level of detail and texel
+    // indices (sample_lanes.h), prepared and read together; a texture bound
+    // twice (glTF occlusion in R of the metal-roughness map) is read once.
     enum { kBase, kMetalRough, kRough, kMetal, kNormal, kOcclusion, kEmissive, kMaps };
     const Texture* maps[kMaps] = {bm.base_color, bm.metallic_roughness, bm.roughness, bm.metallic,
                                   bm.normal, bm.occlusion, bm.emissive};
+    const bool mask_mode = m.alpha_mode == AlphaMode::Mask;
+    const std::uint8_t used[kMaps] = {std::uint8_t(mask_mode ? 0xF : 0x7), 0x6, 0x1, 0x1, 0x7, 0x1, 0x7};
     TexelLanes texel[kMaps];
+    const TexelLanes* tl[kMaps];
+    for (int i = 0; i < kMaps; ++i) tl[i] = &texel[i];
     if (maps[kBase] || maps[kMetalRough] || maps[kRough] || maps[kMetal] || maps[kNormal] || maps[kOcclusion] ||
         maps[kEmissive]) {
         std::uint32_t live_quads = 0;
@@ -83,13 +89,24 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         int groups = 0;
         const Texture* group_tex[kMaps][kMaps];
         TexelLanes* group_out[kMaps][kMaps];
+        std::uint8_t group_used[kMaps][kMaps];
         int group_size[kMaps];
         for (int i = 0; i < kMaps; ++i) {
             if (!maps[i]) continue;
+            int j = 0;
+            while (j < i && maps[j] != maps[i]) ++j;
+            if (j < i) {  // the same texture again: share its lookup
+                tl[i] = tl[j];
+                for (int g = 0; g < groups; ++g)
+                    for (int k = 0; k < group_size[g]; ++k)
+                        if (group_tex[g][k] == maps[i]) group_used[g][k] |= used[i];
+                continue;
+            }
             int g = 0;
             while (g < groups && !same_sampling_layout(*group_tex[g][0], *maps[i])) ++g;
             if (g == groups) group_size[groups++] = 0;
             group_tex[g][group_size[g]] = maps[i];
+            group_used[g][group_size[g]] = used[i];
             group_out[g][group_size[g]++] = &texel[i];
         }
         for (int g = 0; g < groups; ++g) {
@@ -100,7 +117,7 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
                 if ((live_quads >> q) & 1u) lambda[q] = first.lod(s.dudx[q], s.dvdx[q], s.dudy[q], s.dvdy[q]);
             TrilinearLanes at;
             prepare_trilinear_lanes<N>(first, s.u, s.v, lambda, s.quad, live, at);
-            fetch_trilinear_lanes<N>(group_tex[g], group_size[g], at, group_out[g]);
+            fetch_trilinear_lanes<N>(group_tex[g], group_size[g], at, group_out[g], group_used[g]);
         }
     }
 
@@ -108,11 +125,12 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     const glm::vec4 bf = m.base_color_factor;
     alignas(64) float alpha[N];
     if (maps[kBase]) {
-        const TexelLanes& t = texel[kBase];
+        const TexelLanes& t = *tl[kBase];
         for (int l = 0; l < N; ++l) {
             mb.ar[l] = bf.r * t.r[l]; mb.ag[l] = bf.g * t.g[l]; mb.ab[l] = bf.b * t.b[l];
-            alpha[l] = bf.a * t.a[l];
         }
+        if (mask_mode)  // alpha matters only to the mask (and is read only then)
+            for (int l = 0; l < N; ++l) alpha[l] = bf.a * t.a[l];
     } else {
         for (int l = 0; l < N; ++l) {
             mb.ar[l] = bf.r; mb.ag[l] = bf.g; mb.ab[l] = bf.b;
@@ -128,16 +146,16 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         roughness[l] = m.roughness_factor;
     }
     if (maps[kMetalRough]) {
-        const TexelLanes& t = texel[kMetalRough];
+        const TexelLanes& t = *tl[kMetalRough];
         for (int l = 0; l < N; ++l) {
             roughness[l] *= t.g[l];
             metallic[l] *= t.b[l];
         }
     }
     if (maps[kRough])
-        for (int l = 0; l < N; ++l) roughness[l] *= texel[kRough].r[l];
+        for (int l = 0; l < N; ++l) roughness[l] *= tl[kRough]->r[l];
     if (maps[kMetal])
-        for (int l = 0; l < N; ++l) metallic[l] *= texel[kMetal].r[l];
+        for (int l = 0; l < N; ++l) metallic[l] *= tl[kMetal]->r[l];
     for (int l = 0; l < N; ++l) {
         // glm::clamp(x, 0, 1) = min(max(x, 0), 1), NaN passing through.
         const float mt = metallic[l] < 0.0f ? 0.0f : metallic[l];
@@ -148,13 +166,13 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
 
     if (maps[kOcclusion]) {
         const float strength = m.occlusion_strength;
-        for (int l = 0; l < N; ++l) mb.occlusion[l] = 1.0f + strength * (texel[kOcclusion].r[l] - 1.0f);
+        for (int l = 0; l < N; ++l) mb.occlusion[l] = 1.0f + strength * (tl[kOcclusion]->r[l] - 1.0f);
     } else {
         for (int l = 0; l < N; ++l) mb.occlusion[l] = 1.0f;
     }
     const glm::vec3 ef = m.emissive_factor;
     if (maps[kEmissive]) {
-        const TexelLanes& t = texel[kEmissive];
+        const TexelLanes& t = *tl[kEmissive];
         for (int l = 0; l < N; ++l) {
             mb.er[l] = ef.r * t.r[l]; mb.eg[l] = ef.g * t.g[l]; mb.eb[l] = ef.b * t.b[l];
         }
@@ -180,7 +198,7 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         // Tangent space, OpenGL convention: red along T (+u), green along
         // B = cross(N, T) * w (up the image). T is re-orthogonalised per pixel.
         alignas(64) float Tx[N], Ty[N], Tz[N], ntx[N], nty[N], ntz[N], nx[N], ny[N], nz[N];
-        const TexelLanes& tex = texel[kNormal];
+        const TexelLanes& tex = *tl[kNormal];
         const float scale = m.normal_scale;
         for (int l = 0; l < N; ++l) {
             const float d = Nx[l] * s.Tx[l] + Ny[l] * s.Ty[l] + Nz[l] * s.Tz[l];
@@ -217,7 +235,7 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
 
     // Alpha MASK: discard below the cutoff (NaN alpha too).
     std::uint32_t kill = 0;
-    if (m.alpha_mode == AlphaMode::Mask) {
+    if (mask_mode) {
         const float cutoff = m.alpha_cutoff;
         for (int l = 0; l < N; ++l) kill |= std::uint32_t(!(alpha[l] >= cutoff)) << l;
     }

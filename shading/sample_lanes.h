@@ -129,30 +129,34 @@ inline void prepare_s(Wrap t, const float* u, const float* v, const LevelLanes& 
 // 4-channel float vector (one texel); lane-wise IEEE operations, no contraction.
 typedef float Float4 __attribute__((vector_size(16)));
 
-// One texel of the chain as a 4-channel vector, whatever the storage.
-inline Float4 load_texel(const Texture& tex, std::int32_t i) {
+// A float texture's texel as a 4-channel vector.
+inline Float4 load_texel(const glm::vec4* texels, std::int32_t i) {
     Float4 r;
-    if (!tex.is_unorm8()) {
-        std::memcpy(&r, &tex.texel_data()[i], sizeof r);
-    } else {
-        const glm::vec4 t = tex.texel_at(std::size_t(i));
-        r = Float4{t.r, t.g, t.b, t.a};
-    }
+    std::memcpy(&r, &texels[i], sizeof r);
     return r;
 }
 
-inline Float4 bilinear(const Texture& tex, const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty,
-                       int l) {
-    const Float4 a = load_texel(tex, idx[0][l]), b = load_texel(tex, idx[1][l]);
-    const Float4 c = load_texel(tex, idx[2][l]), d = load_texel(tex, idx[3][l]);
+// Any storage (the non-AVX2 builds' path for 8-bit textures).
+inline Float4 load_texel(const Texture* tex, std::int32_t i) {
+    if (!tex->is_unorm8()) return load_texel(tex->texel_data(), i);
+    const glm::vec4 t = tex->texel_at(std::size_t(i));
+    return Float4{t.r, t.g, t.b, t.a};
+}
+
+template <class Texels>
+[[gnu::always_inline]] inline Float4 bilinear(const Texels& texels, const std::int32_t (*idx)[kMaxN], const float* tx,
+                                              const float* ty, int l) {
+    const Float4 a = load_texel(texels, idx[0][l]), b = load_texel(texels, idx[1][l]);
+    const Float4 c = load_texel(texels, idx[2][l]), d = load_texel(texels, idx[3][l]);
     const Float4 top = a + (b - a) * tx[l];
     const Float4 bottom = c + (d - c) * tx[l];
     return top + (bottom - top) * ty[l];
 }
 
-// The live lanes one at a time, for K textures of any storage.
-template <int N, int K>
-inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLanes& at, TexelLanes* const* out) {
+// The live lanes one at a time, for K textures: src[k] is a float texture's
+// texel array, or the Texture itself (any storage).
+template <int N, int K, class Texels>
+inline void fetch_lanes_one_by_one(const Texels* const* src, const TrilinearLanes& at, TexelLanes* const* out) {
     if (at.live != (1u << N) - 1u) {
         for (int k = 0; k < K; ++k)
             for (int l = 0; l < N; ++l) out[k]->r[l] = out[k]->g[l] = out[k]->b[l] = out[k]->a[l] = 0.0f;
@@ -160,10 +164,10 @@ inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLan
     for (std::uint32_t m = at.live; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         Float4 c[K];
-        for (int k = 0; k < K; ++k) c[k] = bilinear(*tex[k], at.ia, at.txa, at.tya, l);
+        for (int k = 0; k < K; ++k) c[k] = bilinear(src[k], at.ia, at.txa, at.tya, l);
         if ((at.blend >> l) & 1u) {
             for (int k = 0; k < K; ++k) {
-                const Float4 cb = bilinear(*tex[k], at.ib, at.txb, at.tyb, l);
+                const Float4 cb = bilinear(src[k], at.ib, at.txb, at.tyb, l);
                 c[k] = c[k] + (cb - c[k]) * at.t[l];
             }
         }
@@ -173,6 +177,19 @@ inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLan
             out[k]->b[l] = c[k][2];
             out[k]->a[l] = c[k][3];
         }
+    }
+}
+
+template <int N, int K>
+inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLanes& at, TexelLanes* const* out) {
+    bool float_only = true;
+    for (int k = 0; k < K; ++k) float_only &= !tex[k]->is_unorm8();
+    if (float_only) {
+        const glm::vec4* texels[K];
+        for (int k = 0; k < K; ++k) texels[k] = tex[k]->texel_data();
+        fetch_lanes_one_by_one<N, K, glm::vec4>(texels, at, out);
+    } else {
+        fetch_lanes_one_by_one<N, K, Texture>(tex, at, out);
     }
 }
 
@@ -262,7 +279,7 @@ inline typename V::F decode_channel(typename V::I words, int c, const float* tab
 
 // Bilinear filter of every stored channel of one level for lanes [l0, l0 + W).
 template <class V, int C>
-inline void bilinear_unorm8(const Texture& tex, const bool* divide, const std::int32_t (*idx)[kMaxN],
+[[gnu::always_inline]] inline void bilinear_unorm8(const Texture& tex, const bool* divide, unsigned need, const std::int32_t (*idx)[kMaxN],
                             const float* tx_lanes, const float* ty_lanes, int l0, typename V::F* result) {
     using F = typename V::F;
     const std::uint8_t* base = tex.unorm8_data();
@@ -272,6 +289,7 @@ inline void bilinear_unorm8(const Texture& tex, const bool* divide, const std::i
     const typename V::I wd = gather_texels<V, C>(base, V::load_i(idx[3] + l0));
     const F tx = V::load_f(tx_lanes + l0), ty = V::load_f(ty_lanes + l0);
     for (int c = 0; c < C; ++c) {
+        if (!((need >> c) & 1u)) continue;
         const float* table = tex.table(c);
         const F a = decode_channel<V>(wa, c, table, divide[c]), b = decode_channel<V>(wb, c, table, divide[c]);
         const F cc = decode_channel<V>(wc, c, table, divide[c]), d = decode_channel<V>(wd, c, table, divide[c]);
@@ -282,33 +300,41 @@ inline void bilinear_unorm8(const Texture& tex, const bool* divide, const std::i
     }
 }
 
-// All N lanes of an 8-bit texture, W at a time; non-live lanes get 0.
+// All N lanes of an 8-bit texture, W at a time; non-live lanes get 0. Only
+// the output components in `components` (bit k: r, g, b, a) are written, and
+// only the stored channels they need are read.
 template <int N, int W, int C>
-inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
     using V = Simd<W>;
     using F = typename V::F;
     bool divide[4];
     for (int c = 0; c < C; ++c) divide[c] = tex.table(c) == unorm8_decode_table();
     float* dst[4] = {out.r, out.g, out.b, out.a};
+    unsigned need = 0;
+    for (int k = 0; k < 4; ++k)
+        if (((components >> k) & 1u) && tex.swizzle(k) != Texture::kOne) need |= 1u << tex.swizzle(k);
     for (int l0 = 0; l0 < N; l0 += W) {
         const unsigned live = (at.live >> l0) & ((1u << W) - 1u);
         if (!live) {
-            for (int k = 0; k < 4; ++k) V::store_f(dst[k] + l0, V::zero_f());
+            for (int k = 0; k < 4; ++k)
+                if ((components >> k) & 1u) V::store_f(dst[k] + l0, V::zero_f());
             continue;
         }
-        F res[4];
-        bilinear_unorm8<V, C>(tex, divide, at.ia, at.txa, at.tya, l0, res);
+        F res[4] = {V::zero_f(), V::zero_f(), V::zero_f(), V::zero_f()};
+        bilinear_unorm8<V, C>(tex, divide, need, at.ia, at.txa, at.tya, l0, res);
         const unsigned blend = (at.blend >> l0) & ((1u << W) - 1u);
         if (blend) {
-            F resb[4];
-            bilinear_unorm8<V, C>(tex, divide, at.ib, at.txb, at.tyb, l0, resb);
+            F resb[4] = {V::zero_f(), V::zero_f(), V::zero_f(), V::zero_f()};
+            bilinear_unorm8<V, C>(tex, divide, need, at.ib, at.txb, at.tyb, l0, resb);
             const F t = V::load_f(at.t + l0);
             const F mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits()));
-            for (int c = 0; c < C; ++c) res[c] = V::select(mask, V::add(res[c], V::mul(V::sub(resb[c], res[c]), t)), res[c]);
+            for (int c = 0; c < C; ++c)
+                if ((need >> c) & 1u) res[c] = V::select(mask, V::add(res[c], V::mul(V::sub(resb[c], res[c]), t)), res[c]);
         }
         const F live_mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(live)), V::lane_bits()), V::lane_bits()));
         const F zero = V::zero_f();
         for (int k = 0; k < 4; ++k) {
+            if (!((components >> k) & 1u)) continue;
             const int sw = tex.swizzle(k);
             const F v = sw == Texture::kOne ? V::set1_f(1.0f) : res[sw];
             V::store_f(dst[k] + l0, V::select(live_mask, v, zero));
@@ -319,7 +345,7 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
 // The stored channels of one 8-bit texel (index i) as a vector, through
 // their tables; channels past C are 0 (never written out).
 template <int C>
-inline Float4 load_unorm8_texel(const std::uint8_t* base, const float* const* table, std::int32_t i) {
+[[gnu::always_inline]] inline Float4 load_unorm8_texel(const std::uint8_t* base, const float* const* table, std::int32_t i) {
     const std::uint8_t* p = base + std::size_t(i) * C;
     Float4 r = {0.0f, 0.0f, 0.0f, 0.0f};
     r[0] = table[0][p[0]];
@@ -330,7 +356,7 @@ inline Float4 load_unorm8_texel(const std::uint8_t* base, const float* const* ta
 }
 
 template <int C>
-inline Float4 bilinear_unorm8_lane(const std::uint8_t* base, const float* const* table,
+[[gnu::always_inline]] inline Float4 bilinear_unorm8_lane(const std::uint8_t* base, const float* const* table,
                                    const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty, int l) {
     const Float4 a = load_unorm8_texel<C>(base, table, idx[0][l]), b = load_unorm8_texel<C>(base, table, idx[1][l]);
     const Float4 c = load_unorm8_texel<C>(base, table, idx[2][l]), d = load_unorm8_texel<C>(base, table, idx[3][l]);
@@ -365,14 +391,14 @@ inline void fetch_unorm8_one_by_one(const Texture& tex, const TrilinearLanes& at
 constexpr int kSparseLanes = 4;
 
 template <int N>
-inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
     constexpr int W = N >= 8 ? 8 : 4;
     const bool sparse = __builtin_popcount(at.live) <= kSparseLanes;
     switch (tex.channels()) {
-    case 1: sparse ? fetch_unorm8_one_by_one<N, 1>(tex, at, out) : fetch_unorm8_lanes<N, W, 1>(tex, at, out); return;
-    case 2: sparse ? fetch_unorm8_one_by_one<N, 2>(tex, at, out) : fetch_unorm8_lanes<N, W, 2>(tex, at, out); return;
-    case 3: sparse ? fetch_unorm8_one_by_one<N, 3>(tex, at, out) : fetch_unorm8_lanes<N, W, 3>(tex, at, out); return;
-    default: sparse ? fetch_unorm8_one_by_one<N, 4>(tex, at, out) : fetch_unorm8_lanes<N, W, 4>(tex, at, out); return;
+    case 1: sparse ? fetch_unorm8_one_by_one<N, 1>(tex, at, out) : fetch_unorm8_lanes<N, W, 1>(tex, at, out, components); return;
+    case 2: sparse ? fetch_unorm8_one_by_one<N, 2>(tex, at, out) : fetch_unorm8_lanes<N, W, 2>(tex, at, out, components); return;
+    case 3: sparse ? fetch_unorm8_one_by_one<N, 3>(tex, at, out) : fetch_unorm8_lanes<N, W, 3>(tex, at, out, components); return;
+    default: sparse ? fetch_unorm8_one_by_one<N, 4>(tex, at, out) : fetch_unorm8_lanes<N, W, 4>(tex, at, out, components); return;
     }
 }
 
@@ -474,9 +500,11 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
 // first N are set to 0. 8-bit textures go through the gathers (AVX2 builds);
 // float ones are read lane by lane, up to three per pass so that the indices
 // and weights are read once and the texel loads of the textures overlap.
+// components[k] (bit 0 r, 1 g, 2 b, 3 a; null: all) says which components of
+// out[k] the caller reads: the gathers skip the others (left unwritten).
 template <int N = kBlockLanes>
 inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const TrilinearLanes& at,
-                                  TexelLanes* const* out) {
+                                  TexelLanes* const* out, const std::uint8_t* components = nullptr) {
     using namespace sample_lanes_detail;
 #ifdef __AVX2__
     const Texture* rest[3];
@@ -484,7 +512,7 @@ inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const Tr
     int n_rest = 0;
     for (int k = 0; k < count; ++k) {
         if (tex[k]->is_unorm8()) {
-            fetch_unorm8_lanes<N>(*tex[k], at, *out[k]);
+            fetch_unorm8_lanes<N>(*tex[k], at, *out[k], components ? components[k] : 0xFu);
             continue;
         }
         rest[n_rest] = tex[k];
@@ -496,6 +524,7 @@ inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const Tr
     }
     fetch_lanes_one_by_one<N>(rest, n_rest, at, rest_out);
 #else
+    (void)components;
     fetch_lanes_one_by_one<N>(tex, count, at, out);
 #endif
 }

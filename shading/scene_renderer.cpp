@@ -6,6 +6,8 @@
 #include <mutex>
 #include <new>
 
+#include "shading/resolve.h"
+
 namespace prast {
 
 std::vector<ShadingLight> shading_lights(const Scene& scene) {
@@ -158,9 +160,12 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
     }
 }
 
-void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb) {
-    renderer_.clear(fb, 0.0f, 0.0f, 0.0f, 1.0f);
+void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out) {
     renderer_.begin_frame();
+    FrameOptions frame;  // cleared to black, alpha 1, depth 1, in the tile pass
+    frame.samples = s.samples;
+    frame.visibility = s.visibility;
+    renderer_.begin(fb, frame);
     ShadingContext ctx;
     ctx.eye = s.camera.eye;
     ctx.lights = s.lights;
@@ -184,15 +189,42 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb) {
         prog.far_plane = s.camera.far_plane;
         DrawState st;
         st.cull = bm->m->double_sided ? CullMode::None : CullMode::Back;
+        st.may_discard = bm->m->alpha_mode == AlphaMode::Mask;  // shaded in order: discards decide visibility
         if (s.view == DebugView::Overdraw) {
             st.blend = Blend::Add;
             st.depth_test = false;
             st.depth_write = false;
         }
-        renderer_.draw(fb, prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(), mesh.indices.size(), st);
+        renderer_.submit(prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(), mesh.indices.size(), st);
     }
+    // The 8-bit image: from each finished tile, unless a whole-image overlay
+    // comes first (then after it, rows in parallel).
+    const bool overlay = s.view == DebugView::Overdraw || s.view == DebugView::Tiles;
+    TileResolve resolve;
+    if (out) {
+        resolve.rgba8 = out->rgba8;
+        resolve.width = fb.width;
+        resolve.exposure = out->exposure;
+        resolve.tonemap = out->tonemap;
+        resolve.raw = out->raw;
+    }
+    if (out && !overlay) renderer_.end(resolve);
+    else renderer_.end();
     if (s.view == DebugView::Overdraw) apply_overdraw_heat(fb);
     if (s.view == DebugView::Tiles) apply_tile_overlay(fb, renderer_.tile_entries(), renderer_.tile_size());
+    if (out && overlay) {
+        constexpr int kRows = 16;
+        renderer_.pool().run((fb.height + kRows - 1) / kRows, [&](int chunk, int) {
+            TileView v;
+            v.x0 = 0;
+            v.y0 = chunk * kRows;
+            v.width = fb.width;
+            v.height = std::min(kRows, fb.height - v.y0);
+            v.rgba = &fb.color[std::size_t(v.y0) * std::size_t(fb.width) * 4];
+            v.row = std::size_t(fb.width) * 4;
+            resolve(v);
+        });
+    }
 }
 
 // Fragments per pixel (in red, counted additively) to a heat ramp:

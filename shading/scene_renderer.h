@@ -14,6 +14,7 @@
 #include "scene/scene.h"
 #include "shading/surface.h"
 #include "shading/texture.h"
+#include "shading/tonemap.h"
 
 namespace prast {
 
@@ -23,6 +24,18 @@ struct FrameSettings {
     glm::vec3 ambient{0.03f};
     BrdfModel model = BrdfModel::Default;
     DebugView view = DebugView::None;
+    int samples = 1;  // per pixel: 1, 2, 4 or 8 (README "Anti-aliasing")
+    // Where the visibility pass runs (the bytes are the same either way).
+    FrameOptions::Visibility visibility = FrameOptions::Visibility::Auto;
+};
+
+// The 8-bit image a frame writes from its tile pass (render's PNG): exposure,
+// tone map, sRGB, 8 bits; or, for data views, the values as they are.
+struct ImageOutput {
+    std::uint8_t* rgba8 = nullptr;  // framebuffer width * height * 4 bytes
+    float exposure = 1.0f;
+    ToneMap tonemap = ToneMap::Aces;
+    bool raw = false;               // resolve_raw8 instead (data debug views)
 };
 
 // Scene lights (KHR_lights_punctual) in shading form.
@@ -39,8 +52,9 @@ public:
     SceneRenderer(const Scene& scene, Renderer& renderer);
 
     // Renders one frame into fb (resized by the caller): clears to black,
-    // draws every mesh, and applies the overdraw/tiles debug overlays.
-    void render(const FrameSettings& settings, Framebuffer& fb);
+    // draws every mesh, and applies the overdraw/tiles debug overlays. With
+    // `out`, also writes the 8-bit image (in the tile pass, on every thread).
+    void render(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out = nullptr);
 
     const std::vector<std::string>& warnings() const { return warnings_; }
     const std::vector<BoundMaterial>& materials() const { return bound_; }

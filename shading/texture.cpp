@@ -149,6 +149,28 @@ const SrgbEncoder& srgb_encoder() {
     return e;
 }
 
+// One output row of the 2x2 case, the channel layout fixed at compile time:
+// C channels, the colour ones sRGB when Srgb (alpha, channel 1 of 2 or 3 of
+// 4, never). Sums of four table values are exact in double (each value is a
+// multiple of 2^-35 below 1), so their order is free.
+template <int C, bool Srgb>
+void downsample_2x2_row(const std::uint8_t* r0, const std::uint8_t* r1, std::uint8_t* out, int dw) {
+    const float* srgb = srgb8_decode_table();
+    const SrgbEncoder& enc = srgb_encoder();
+    constexpr int kAlpha = C == 2 ? 1 : (C == 4 ? 3 : -1);
+    for (int i = 0; i < dw; ++i, r0 += 2 * C, r1 += 2 * C, out += C) {
+        for (int c = 0; c < C; ++c) {
+            if (Srgb && c != kAlpha) {
+                const double sum = (double(srgb[r0[c]]) + double(srgb[r0[C + c]])) +
+                                   (double(srgb[r1[c]]) + double(srgb[r1[C + c]]));
+                out[c] = enc.encode(sum * 0.25);
+            } else {
+                out[c] = std::uint8_t((r0[c] + r0[C + c] + r1[c] + r1[C + c] + 2) >> 2);
+            }
+        }
+    }
+}
+
 // Output rows [j0, j1) of an 8-bit level from the level above, channel by
 // channel: linear channels exactly in integers (round half up), sRGB ones as
 // the area-weighted mean of the decoded values (in double: the weighted sum of
@@ -167,20 +189,16 @@ void downsample_unorm8(const std::uint8_t* src, int sw, int sh, std::uint8_t* ds
         for (int b = 0; b < ty.count; ++b) rows[b] = src + std::size_t(ty.first + b) * std::size_t(sw) * C;
         if (ty.count == 2 && sw % 2 == 0) {
             // The common case, 2x2 texels of weight 1/4.
-            const std::uint8_t* r0 = rows[0];
-            const std::uint8_t* r1 = rows[1];
-            for (int i = 0; i < dw; ++i) {
-                const std::size_t a = std::size_t(2 * i) * C, b = a + C;
-                for (std::size_t c = 0; c < C; ++c) {
-                    if (srgb_channel[c]) {
-                        const double sum = double(srgb[r0[a + c]]) + double(srgb[r0[b + c]]) +
-                                           double(srgb[r1[a + c]]) + double(srgb[r1[b + c]]);
-                        out[std::size_t(i) * C + c] = enc.encode(sum / 4.0);
-                    } else {
-                        const int sum = r0[a + c] + r0[b + c] + r1[a + c] + r1[b + c];
-                        out[std::size_t(i) * C + c] = std::uint8_t((sum + 2) >> 2);
-                    }
-                }
+            const bool colour_srgb = srgb_channel[0];
+            switch (channels * 2 + int(colour_srgb)) {
+            case 2: downsample_2x2_row<1, false>(rows[0], rows[1], out, dw); break;
+            case 3: downsample_2x2_row<1, true>(rows[0], rows[1], out, dw); break;
+            case 4: downsample_2x2_row<2, false>(rows[0], rows[1], out, dw); break;
+            case 5: downsample_2x2_row<2, true>(rows[0], rows[1], out, dw); break;
+            case 6: downsample_2x2_row<3, false>(rows[0], rows[1], out, dw); break;
+            case 7: downsample_2x2_row<3, true>(rows[0], rows[1], out, dw); break;
+            case 8: downsample_2x2_row<4, false>(rows[0], rows[1], out, dw); break;
+            default: downsample_2x2_row<4, true>(rows[0], rows[1], out, dw); break;
             }
             continue;
         }

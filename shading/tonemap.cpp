@@ -7,6 +7,7 @@
 #include <cstddef>
 
 #include "shading/color.h"
+#include "shading/resolve.h"
 
 namespace prast {
 
@@ -63,19 +64,6 @@ inline glm::vec3 tonemap_fixed(glm::vec3 c) {
     }
 }
 
-// The pixel loop, one instance per tone map so the switch is outside it.
-template <ToneMap TM>
-void resolve_pixels(const float* in, std::size_t count, float exposure, std::uint8_t* out) {
-    const Srgb8Encoder& encode = Srgb8Encoder::instance();
-    for (std::size_t i = 0; i < count; ++i, in += 4, out += 4) {
-        glm::vec3 c = tonemap_fixed<TM>(glm::vec3(in[0], in[1], in[2]) * exposure);
-        out[0] = encode(c.r);
-        out[1] = encode(c.g);
-        out[2] = encode(c.b);
-        out[3] = static_cast<std::uint8_t>(std::floor(clamp01(in[3]) * 255.0f + 0.5f));
-    }
-}
-
 } // namespace
 
 bool parse_tonemap(const std::string& s, ToneMap& out) {
@@ -107,24 +95,11 @@ void resolve_to_srgb8(const float* rgba_linear, int width, int height, float exp
                       ToneMap tm, std::uint8_t* rgba8_out) {
     assert(width >= 0 && height >= 0);
     assert((rgba_linear && rgba8_out) || width == 0 || height == 0);
-    std::size_t count = std::size_t(width) * std::size_t(height);
-    switch (tm) {
-    case ToneMap::Aces: resolve_pixels<ToneMap::Aces>(rgba_linear, count, exposure, rgba8_out); break;
-    case ToneMap::Neutral: resolve_pixels<ToneMap::Neutral>(rgba_linear, count, exposure, rgba8_out); break;
-    case ToneMap::None: resolve_pixels<ToneMap::None>(rgba_linear, count, exposure, rgba8_out); break;
-    }
+    resolve_pixels_srgb8(rgba_linear, std::size_t(width) * std::size_t(height), exposure, tm, rgba8_out);
 }
 
 void resolve_raw8(const float* rgba, int width, int height, std::uint8_t* out) {
-    std::size_t count = std::size_t(width) * std::size_t(height);
-    for (std::size_t i = 0; i < count; ++i) {
-        for (int c = 0; c < 3; ++c) {
-            float x = rgba[i * 4 + c];
-            x = x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f;  // NaN -> 0
-            out[i * 4 + c] = std::uint8_t(std::floor(x * 255.0f + 0.5f));
-        }
-        out[i * 4 + 3] = 255;
-    }
+    resolve_pixels_raw8(rgba, std::size_t(width) * std::size_t(height), out);
 }
 
 } // namespace prast

@@ -21,6 +21,8 @@ const char* tonemap_name(ToneMap tm);
 // Neutral is the Khronos PBR Neutral operator (negative input clamped to 0).
 glm::vec3 tonemap(glm::vec3 linear, ToneMap tm);
 
+// The whole-image resolve (resolve.h has the per-run and per-tile forms,
+// vectorised; the bytes are the same).
 // For each pixel: rgb * exposure, tonemap, sRGB encode, round to 8 bits
 // (byte-identical to linear_to_srgb8); alpha is not exposed nor encoded:
 // floor(clamp(a, 0, 1) * 255 + 0.5). Both buffers are width * height RGBA,

@@ -12,6 +12,7 @@
 #include "shading/color.h"
 #include "shading/tonemap.h"
 #include "stepper/format.h"
+#include "raster/samples.h"
 #include "stepper/frame_loop.h"
 
 namespace prast::stepper {
@@ -150,26 +151,33 @@ TileWalk walk_tile(const Recording& rec, std::uint32_t piece, int tile) {
     const int tx1 = std::min(tx0 + ts, rec.width) - 1, ty1 = std::min(ty0 + ts, rec.height) - 1;
     const int x0 = std::max(tx0, t.minx), x1 = std::min(tx1, t.maxx);
     const int y0 = std::max(ty0, t.miny), y1 = std::min(ty1, t.maxy);
+    const SamplePattern& sp = sample_pattern(rec.samples);
+    const SampleExtent ext = sample_extent(sp);
     auto count_coverage = [&](int bx, int by, unsigned partial) {
+        // A lane is covered when any of its samples is inside the partial edges.
         std::uint32_t mask = 0;
         for (int l = 0; l < kBlockLanes; ++l) {
             const int x = bx + lane_x(l), y = by + lane_y(l);
             if (x >= rec.width || y >= rec.height) continue;
-            bool in = true;
-            for (int e = 0; e < 3; ++e)
-                if ((partial & (1u << e)) && edge_at_pixel(t, e, x, y) < 0) in = false;
-            if (in) mask |= 1u << l;
+            for (int smp = 0; smp < sp.count; ++smp) {
+                bool in = true;
+                for (int e = 0; e < 3; ++e)
+                    if ((partial & (1u << e)) && edge_at_pixel(t, e, x, y) + std::int64_t(t.A[e]) * sp.fixed_x(smp) +
+                                                         std::int64_t(t.B[e]) * sp.fixed_y(smp) < 0)
+                        in = false;
+                if (in) mask |= 1u << l;
+            }
         }
         if (mask) ++w.fine_with_coverage;
     };
     if (x0 <= x1 && y0 <= y1) {
-        // rasterize_triangle(): 16x16 blocks, then 4x4 blocks of the partial ones.
+        // for_each_block() (rasterize.h): 16x16 blocks, then 4x4 blocks of the partial ones.
         for (int cy = y0 & ~(kCoarseBlockSize - 1); cy <= y1; cy += kCoarseBlockSize)
             for (int cx = x0 & ~(kCoarseBlockSize - 1); cx <= x1; cx += kCoarseBlockSize) {
                 unsigned partial = 0;
                 bool out = false;
                 for (int e = 0; e < 3 && !out; ++e) {
-                    const EdgeClass c = classify_block(t, e, cx, cy, kCoarseBlockSize);
+                    const EdgeClass c = classify_block(t, e, cx, cy, kCoarseBlockSize, ext);
                     if (c == kEdgeOut) out = true;
                     else if (c == kEdgePartial) partial |= 1u << e;
                 }
@@ -189,7 +197,7 @@ TileWalk walk_tile(const Recording& rec, std::uint32_t piece, int tile) {
                         bool block_out = false;
                         for (int e = 0; e < 3 && !block_out; ++e) {
                             if (!(partial & (1u << e))) continue;
-                            const EdgeClass c = classify_block(t, e, bx, by, kBlockSize);
+                            const EdgeClass c = classify_block(t, e, bx, by, kBlockSize, ext);
                             if (c == kEdgeOut) block_out = true;
                             else if (c == kEdgePartial) block_partial |= 1u << e;
                         }
@@ -216,7 +224,7 @@ std::string frame_text(const StepScene& s, const Recording& rec) {
     std::ostringstream o;
     const Camera& c = s.settings.camera;
     o << "frame " << rec.width << "x" << rec.height << ", tiles of " << rec.tile_size << " (" << rec.tiles_x << "x"
-      << rec.tiles_y << ")\n";
+      << rec.tiles_y << "), " << rec.samples << " sample" << (rec.samples == 1 ? "" : "s") << " per pixel\n";
     o << "scene " << (s.options.scene.empty() ? "built-in" : s.options.scene) << ": " << rec.triangle_count()
       << " triangles, " << s.scene.meshes.size() << " meshes, " << s.scene.materials.size() << " materials\n";
     o << "camera eye " << vec(c.eye) << " target " << vec(c.target) << " up " << vec(c.up) << " fov "
@@ -249,6 +257,7 @@ json frame_json(const StepScene& s, const Recording& rec) {
     j["width"] = rec.width;
     j["height"] = rec.height;
     j["tile_size"] = rec.tile_size;
+    j["samples"] = rec.samples;
     j["tiles_x"] = rec.tiles_x;
     j["tiles_y"] = rec.tiles_y;
     j["triangles"] = rec.triangle_count();
@@ -328,11 +337,14 @@ std::string triangle_text(const StepScene& s, const Recording& rec, std::uint32_
               << "\n";
         }
         if (!consistent) o << "    NOTE: the snapped vertices above do not reproduce A and B\n";
+        if (rec.samples > 1)
+            o << "    " << rec.samples << " samples per pixel: sample s at (dx, dy) 1/256 px from the centre tests E + A dx + "
+                 "B dy >= 0 (dx, dy multiples of 16)\n";
         const std::int64_t area2 = (sv[1].fx - sv[0].fx) * (sv[2].fy - sv[0].fy) - (sv[2].fx - sv[0].fx) * (sv[1].fy - sv[0].fy);
         o << "    area " << num(double(area2 < 0 ? -area2 : area2) / (2.0 * 65536.0)) << " px (2 x area = " << area2
           << " in 1/65536 px^2)\n";
         o << "    box x " << t.minx << ".." << t.maxx << " y " << t.miny << ".." << t.maxy << "\n";
-        o << "    barycentric planes at the box corner: b0 " << num(t.bary[0][0]) << " + " << num(t.bary[0][1])
+        o << "    barycentric planes at the pixel centre (" << t.ax << ", " << t.ay << "): b0 " << num(t.bary[0][0]) << " + " << num(t.bary[0][1])
           << " dx + " << num(t.bary[0][2]) << " dy; b1 " << num(t.bary[1][0]) << " + " << num(t.bary[1][1]) << " dx + "
           << num(t.bary[1][2]) << " dy; b2 " << num(t.bary[2][0]) << " + " << num(t.bary[2][1]) << " dx + "
           << num(t.bary[2][2]) << " dy\n";
@@ -433,44 +445,96 @@ json tile_json(const StepScene& s, const Recording& rec, int tx, int ty) {
 
 // ---------------------------------------------------------------- pixel
 
+glm::vec3 resolve_average(const glm::vec3* colors, int samples) {
+    glm::vec3 out(0.0f);
+    const float inv = 1.0f / float(samples);
+    for (int ch = 0; ch < 3; ++ch) {
+        float v[kMaxSamples] = {};
+        for (int i = 0; i < samples; ++i) v[i] = colors[i][ch];
+        for (int n = samples; n > 1; n /= 2)
+            for (int i = 0; i < n / 2; ++i) v[i] = v[2 * i] + v[2 * i + 1];
+        out[ch] = v[0] * inv;
+    }
+    return out;
+}
+
 PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, int y) {
     PixelExplanation px;
     px.x = x;
     px.y = y;
+    px.samples = rec.samples;
+    const int S = rec.samples;
     const ShadingContext ctx = shading_context(s.settings);
     const TileRecord& tile = rec.tiles[std::size_t(rec.tile_of(x, y))];
     const int bx = x & ~(kBlockSize - 1), by = y & ~(kBlockSize - 1);
-    int lane = 0;
     for (int l = 0; l < kBlockLanes; ++l)
-        if (lane_x(l) == x - bx && lane_y(l) == y - by) lane = l;
-    float depth = 1.0f;                 // cleared
-    glm::vec3 color(0.0f);              // cleared to black
+        if (lane_x(l) == x - bx && lane_y(l) == y - by) px.lane = l;
+    const int lane = px.lane;
+    // The tile pass, sample by sample: cleared, then each fragment in the
+    // tile's order. A draw taking the visibility pass writes depth and makes
+    // the fragment the sample's winner (`pending`), shaded once later; a draw
+    // shaded in order writes its colour at once.
+    for (int i = 0; i < S; ++i) {
+        px.sample_depth[i] = 1.0f;
+        px.sample_color[i] = glm::vec3(0.0f);
+        px.sample_owner[i] = -1;
+    }
+    int pending[kMaxSamples];
+    for (int i = 0; i < S; ++i) pending[i] = -1;
     for (const BlockRecord& b : tile.blocks) {
         if (b.bx != bx || b.by != by || !(b.mask & (1u << lane))) continue;
         HistoryEntry h;
         h.piece = b.piece;
         h.lane = lane;
         h.block = &b;
-        h.z = tile.z[b.z + std::size_t(__builtin_popcount(b.mask & ((1u << lane) - 1u)))];
-        h.depth_before = depth;
-        h.color_before = color;
-        h.passed = (b.pass >> lane) & 1u;
+        const std::uint32_t tri = rec.pieces[b.piece].triangle;
+        const DrawRecord& d = rec.draw_of(tri);
+        h.visible = d.visible;
+        for (int i = 0; i < S; ++i) {
+            if (!((rec.cover(tile, b, i) >> lane) & 1u)) continue;
+            h.cover |= 1u << i;
+            h.z[i] = rec.depth(tile, b, i, lane);
+            h.depth_before[i] = px.sample_depth[i];
+            if ((rec.pass(tile, b, i) >> lane) & 1u) h.pass |= 1u << i;
+        }
+        h.shaded = (b.shaded >> lane) & 1u;
         h.written = (b.live >> lane) & 1u;
-        h.killed = h.passed && !h.written;
+        h.killed = h.shaded && !h.written;
         replay_block(s, rec, b, h.replay);
-        if (h.passed) {
-            h.shading = shade_lane(ctx, material_of(s, rec, rec.pieces[b.piece].triangle), h.replay, lane);
-            if (h.written) {
-                depth = h.z;  // every draw of the frame writes depth
-                color = h.shading.Lo;
+        if (h.shaded) h.shading = shade_lane(ctx, material_of(s, rec, tri), h.replay, lane);
+        const int index = int(px.history.size());
+        for (int i = 0; i < S; ++i) {
+            if (!((h.pass >> i) & 1u)) continue;
+            if (h.visible) {
+                px.sample_depth[i] = h.z[i];
+                pending[i] = index;
+            } else if (h.written) {
+                if (d.state.depth_write) px.sample_depth[i] = h.z[i];
+                px.sample_color[i] = h.shading.Lo;
+                px.sample_owner[i] = index;
+                pending[i] = -1;
             }
         }
-        h.color_after = color;
         px.history.push_back(std::move(h));
-        if (px.history.back().written) px.winner = int(px.history.size()) - 1;
     }
-    // The resolve of conventions.md "Output", on this one pixel.
-    px.linear = color_of(rec.fb, x, y);
+    // The visibility pass's winners, shaded once per pixel: their colour.
+    for (int i = 0; i < S; ++i) {
+        if (pending[i] < 0) continue;
+        const HistoryEntry& w = px.history[std::size_t(pending[i])];
+        px.sample_owner[i] = pending[i];
+        px.sample_color[i] = w.written ? w.shading.Lo : glm::vec3(0.0f);
+    }
+    for (int i = 0; i < S; ++i)
+        if (px.sample_owner[i] >= 0) px.history[std::size_t(px.sample_owner[i])].owns |= 1u << i;
+    for (int k = 0; k < int(px.history.size()); ++k)
+        if (px.history[std::size_t(k)].owns) px.contributors.push_back(k);
+    std::stable_sort(px.contributors.begin(), px.contributors.end(), [&](int a, int b) {
+        return __builtin_popcount(px.history[std::size_t(a)].owns) > __builtin_popcount(px.history[std::size_t(b)].owns);
+    });
+
+    // The resolve (the samples' average), then conventions.md "Output".
+    px.linear = resolve_average(px.sample_color, S);
+    px.framebuffer = color_of(rec.fb, x, y);
     px.exposed = px.linear * s.exposure();
     px.toned = tonemap(px.exposed, s.tonemap());
     const float rgba[4] = {px.linear.r, px.linear.g, px.linear.b, 1.0f};
@@ -550,14 +614,35 @@ void shading_text(std::ostringstream& o, const StepScene& s, const Recording& re
 
 } // namespace
 
+namespace {
+
+std::string sample_list(std::uint32_t bits, int samples) {
+    std::string out;
+    for (int i = 0; i < samples; ++i)
+        if ((bits >> i) & 1u) out += (out.empty() ? "" : ",") + std::to_string(i);
+    return out.empty() ? "none" : out;
+}
+
+std::string entry_name(const Recording& rec, const PixelExplanation& px, int k) {
+    return "#" + std::to_string(k + 1) + " (tri " + std::to_string(rec.pieces[px.history[std::size_t(k)].piece].triangle) +
+           ")";
+}
+
+} // namespace
+
 std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExplanation& px) {
     std::ostringstream o;
     const int tile = rec.tile_of(px.x, px.y);
-    int lane = 0;
-    for (int l = 0; l < kBlockLanes; ++l)
-        if (lane_x(l) == (px.x & 3) && lane_y(l) == (px.y & 3)) lane = l;
+    const int S = px.samples;
+    const SamplePattern& pattern = sample_pattern(S);
     o << "pixel " << px.x << " " << px.y << ": tile " << tile % rec.tiles_x << " " << tile / rec.tiles_x << ", block "
-      << (px.x & ~3) << " " << (px.y & ~3) << " lane " << lane << "\n";
+      << (px.x & ~3) << " " << (px.y & ~3) << " lane " << px.lane << "\n";
+    if (S > 1) {
+        o << S << " samples per pixel (MSAA), at the pixel centre plus (in pixels):";
+        for (int i = 0; i < S; ++i)
+            o << " s" << i << " (" << num(pattern.pixel_x(i)) << ", " << num(pattern.pixel_y(i)) << ")";
+        o << "\n";
+    }
     o << "history: cleared to (0, 0, 0) depth 1, then " << px.history.size() << " fragment"
       << (px.history.size() == 1 ? "" : "s") << " in submission order\n";
     for (std::size_t i = 0; i < px.history.size(); ++i) {
@@ -573,32 +658,71 @@ std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExpl
           << (p.triangle - d.first_triangle) << ", material " << quoted(material_of(s, rec, p.triangle).m->name)
           << ", " << (t.front_facing ? "front" : "back") << " face)\n";
         const int l = h.lane;
+        if (S > 1) o << "     covers samples " << sample_list(h.cover, S) << " of " << S << "\n";
         o << "     barycentrics screen (" << num(h.replay.bary[0][l]) << ", " << num(h.replay.bary[1][l]) << ", "
           << num(h.replay.bary[2][l]) << ") perspective (" << num(h.replay.persp[0][l]) << ", "
-          << num(h.replay.persp[1][l]) << ", " << num(h.replay.persp[2][l]) << ")\n";
+          << num(h.replay.persp[1][l]) << ", " << num(h.replay.persp[2][l]) << ")";
+        if (h.replay.centroid_of[l])
+            o << " at the centroid of samples " << sample_list(h.replay.centroid_of[l], S) << " ("
+              << num(h.replay.at_x[l]) << ", " << num(h.replay.at_y[l]) << ") px: the centre is outside";
+        o << "\n";
         o << "     P " << vec(sp.P) << " N " << vec(sp.N) << " uv " << vec(sp.uv) << " T " << vec(sp.T) << "\n";
-        o << "     depth " << num(h.z) << " vs buffer " << num(h.depth_before) << ": ";
-        if (!h.passed) {
-            o << "failed the depth test (LESS)\n";
-            continue;
+        bool consistent = true;
+        for (int k = 0; k < S; ++k) {
+            if (!((h.cover >> k) & 1u)) continue;
+            const bool passed = (h.pass >> k) & 1u;
+            consistent &= passed == (h.z[k] < h.depth_before[k]);
+            if (S == 1) o << "     depth " << num(h.z[k]) << " vs buffer " << num(h.depth_before[k]) << ": "
+                          << (passed ? "passed" : "failed the depth test (LESS)") << "\n";
+            else o << "     sample " << k << ": depth " << num(h.z[k]) << " vs " << num(h.depth_before[k]) << ": "
+                   << (passed ? "passed" : "failed (LESS)") << "\n";
         }
-        o << "passed; ";
-        if (h.killed)
-            o << "discarded by the shader (alpha " << num(h.shading.ms.alpha) << " below the cutoff)\n";
-        else
-            o << "shader out " << vec(h.shading.Lo) << ", colour " << vec(h.color_before) << " -> "
-              << vec(h.color_after) << "\n";
-        if (h.z != h.replay.in.z[l]) o << "     NOTE: recomputed depth " << num(h.replay.in.z[l]) << "\n";
+        if (!consistent) o << "     NOTE: a recorded depth test disagrees with the depths above\n";
+        if (!h.pass) {
+            o << "     hidden: the depth test failed at every sample it covers\n";
+        } else if (h.visible) {
+            o << "     visibility pass: depth written, the winner of sample" << (__builtin_popcount(h.pass) > 1 ? "s " : " ")
+              << sample_list(h.pass, S) << " so far\n";
+            if (!h.shaded)
+                o << "     not shaded: later fragments won all its samples (the visibility pass shades winners only)\n";
+            else
+                o << "     shaded once, after the tile's depth pass (it kept sample"
+                  << (__builtin_popcount(h.owns) > 1 ? "s " : " ") << sample_list(h.owns, S) << "): shader out "
+                  << vec(h.shading.Lo) << "\n";
+        } else if (h.killed) {
+            o << "     shaded in order (alpha mask): discarded by the shader (alpha " << num(h.shading.ms.alpha)
+              << " below the cutoff)\n";
+        } else if (h.shaded) {
+            o << "     shaded in order (" << (d.state.may_discard ? "alpha mask" : "no visibility pass")
+              << "): shader out " << vec(h.shading.Lo) << ", written to sample" << (__builtin_popcount(h.pass) > 1 ? "s " : " ")
+              << sample_list(h.pass, S) << "\n";
+        }
+        if (h.shaded && h.replay.in.z[l] != h.z[0] && S == 1)
+            o << "     NOTE: recomputed depth " << num(h.replay.in.z[l]) << "\n";
     }
-    if (px.winner < 0) {
+    if (S > 1) {
+        o << "samples after the frame:\n";
+        for (int k = 0; k < S; ++k) {
+            o << "  s" << k << " ";
+            if (px.sample_owner[k] < 0) o << "cleared";
+            else o << entry_name(rec, px, px.sample_owner[k]);
+            o << " depth " << num(px.sample_depth[k]) << " colour " << vec(px.sample_color[k]) << "\n";
+        }
+        o << "resolve: the average of the " << S << " samples (summed pairwise) = " << vec(px.linear) << "\n";
+    }
+    if (px.contributors.empty()) {
         o << "no fragment was written: the background\n";
     } else {
-        const HistoryEntry& w = px.history[std::size_t(px.winner)];
-        o << "shading of #" << px.winner + 1 << " (tri " << rec.pieces[w.piece].triangle << "), lane " << w.lane
-          << " of its 4x4 block:\n";
-        shading_text(o, s, rec, w);
-        if (w.shading.Lo != px.linear) o << "  NOTE: the framebuffer holds " << vec(px.linear) << "\n";
+        for (int k : px.contributors) {
+            const HistoryEntry& w = px.history[std::size_t(k)];
+            o << "shading of " << entry_name(rec, px, k) << ", lane " << w.lane << " of its 4x4 block";
+            if (S > 1) o << ", colour of sample" << (__builtin_popcount(w.owns) > 1 ? "s " : " ") << sample_list(w.owns, S);
+            o << ":\n";
+            shading_text(o, s, rec, w);
+        }
     }
+    if (std::memcmp(&px.framebuffer, &px.linear, sizeof px.linear))
+        o << "NOTE: the recorded frame holds " << vec(px.framebuffer) << "\n";
     o << "linear " << vec(px.linear) << "\n";
     o << "exposure " << num(s.exposure()) << " -> " << vec(px.exposed) << "\n";
     o << "tone map " << tonemap_name(s.tonemap()) << " -> " << vec(px.toned) << "\n";
@@ -610,18 +734,38 @@ json pixel_json(const StepScene& s, const Recording& rec, const PixelExplanation
     json j;
     j["x"] = px.x;
     j["y"] = px.y;
+    j["samples"] = px.samples;
     json hist = json::array();
     for (const HistoryEntry& h : px.history) {
         json e;
         e["tri"] = rec.pieces[h.piece].triangle;
         e["mesh"] = mesh_name(s, rec, rec.pieces[h.piece].triangle);
-        e["depth"] = h.z;
-        e["result"] = !h.passed ? "depth test failed" : h.killed ? "discarded" : "written";
-        if (h.passed && !h.killed) e["out"] = j3(h.shading.Lo);
+        e["depth"] = h.z[__builtin_ctz(h.cover)];
+        e["cover"] = sample_list(h.cover, px.samples);
+        e["pass"] = sample_list(h.pass, px.samples);
+        e["owns"] = sample_list(h.owns, px.samples);
+        e["result"] = !h.pass ? "depth test failed" : h.killed ? "discarded" : !h.shaded ? "passed, not shaded (later ones won)"
+                      : h.visible ? "shaded once (won samples " + sample_list(h.owns, px.samples) + ")" : "written";
+        if (h.written) e["out"] = j3(h.shading.Lo);
         hist.push_back(e);
     }
     j["history"] = hist;
-    j["winner"] = px.winner;
+    json samples = json::array();
+    for (int k = 0; k < px.samples; ++k) {
+        json e;
+        e["owner"] = px.sample_owner[k];
+        e["depth"] = px.sample_depth[k];
+        e["color"] = j3(px.sample_color[k]);
+        // The sample alone through exposure, tone map and sRGB, to show it.
+        const float rgba[4] = {px.sample_color[k].r, px.sample_color[k].g, px.sample_color[k].b, 1.0f};
+        std::uint8_t srgb[4];
+        resolve_to_srgb8(rgba, 1, 1, s.exposure(), s.tonemap(), srgb);
+        e["srgb8"] = json::array({srgb[0], srgb[1], srgb[2]});
+        e["offset"] = json::array({sample_pattern(px.samples).pixel_x(k), sample_pattern(px.samples).pixel_y(k)});
+        samples.push_back(e);
+    }
+    j["sample_list"] = samples;
+    j["winner"] = px.contributors.empty() ? -1 : px.contributors[0];
     j["linear"] = j3(px.linear);
     j["srgb8"] = json::array({px.srgb8[0], px.srgb8[1], px.srgb8[2]});
     j["text"] = pixel_text(s, rec, px);

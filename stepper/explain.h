@@ -30,28 +30,42 @@ struct TileWalk {
 };
 TileWalk walk_tile(const Recording& rec, std::uint32_t piece, int tile);
 
-// One fragment of a pixel's history.
+// One fragment of a pixel's history: a triangle piece covering at least one
+// of the pixel's samples, in the order the tile ran it.
 struct HistoryEntry {
     std::uint32_t piece = 0;
     int lane = 0;
     const BlockRecord* block = nullptr;
-    float z = 0.0f;               // the fragment's depth (recorded)
-    float depth_before = 1.0f;    // the buffer's depth when it was tested
-    glm::vec3 color_before{0.0f}, color_after{0.0f};
-    bool passed = false, written = false, killed = false;
+    bool visible = false;         // its draw took the visibility pass (else shaded in order)
+    std::uint32_t cover = 0;      // bit s: sample s inside the triangle
+    std::uint32_t pass = 0;       // bit s: ... and passed the depth test (recorded)
+    float z[kMaxSamples] = {};             // depth at each covered sample (recorded)
+    float depth_before[kMaxSamples] = {};  // the sample's depth when it was tested
+    bool shaded = false;          // the fragment program ran for it (once for the pixel)
+    bool written = false, killed = false;  // its colour was written / it was discarded
+    std::uint32_t owns = 0;       // bit s: sample s ends the frame with its colour
     ReplayedBlock replay;
-    LaneShading shading;          // only when it passed the depth test (the shader ran)
+    LaneShading shading;          // only when shaded
 };
 
 struct PixelExplanation {
-    int x = 0, y = 0;
+    int x = 0, y = 0, lane = 0;
+    int samples = 1;
     std::vector<HistoryEntry> history;
-    int winner = -1;              // index into history of the last written fragment
-    glm::vec3 linear{0.0f};       // the framebuffer's value: what render --output .hdr writes
+    int sample_owner[kMaxSamples];         // history index whose colour sample s holds; -1: cleared
+    glm::vec3 sample_color[kMaxSamples];   // each sample's final linear colour
+    float sample_depth[kMaxSamples];
+    std::vector<int> contributors;         // history indices owning samples, most samples first
+    glm::vec3 linear{0.0f};       // the resolve of the samples: what render --output .hdr writes
+    glm::vec3 framebuffer{0.0f};  // the recorded frame's value (equal to linear, or a NOTE says so)
     glm::vec3 exposed{0.0f}, toned{0.0f};
     std::uint8_t srgb8[3] = {0, 0, 0};
 };
 PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, int y);
+
+// The resolve of raster/resolve.cpp on one pixel: pairwise sums of the
+// samples' linear colours, times 1 / samples.
+glm::vec3 resolve_average(const glm::vec3* colors, int samples);
 
 std::string frame_text(const StepScene& s, const Recording& rec);
 std::string triangle_text(const StepScene& s, const Recording& rec, std::uint32_t tri);

@@ -1,5 +1,6 @@
-// The frame, drawn the way SceneRenderer::render draws it (clear, then one
-// draw per mesh with the PBR program, in scene order), with two additions
+// The frame, drawn the way SceneRenderer::render draws it (one frame: cleared
+// in the tile pass, one draw per mesh with the PBR program, in scene order,
+// with render's samples per pixel), with two additions
 // for the stepper: a stage observer (raster/observer.h) and a limit on the
 // number of triangles, for "the image after the first N triangles".
 // tests/test_step.cpp proves the result equal to `render`'s, byte for byte.
@@ -8,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "raster/pipeline.h"
 #include "shading/pbr_program.h"
@@ -34,15 +36,39 @@ inline ShadingContext shading_context(const FrameSettings& s) {
     return ctx;
 }
 
-// An observer that also hears which draw comes next.
-//   void begin_draw(int mesh, std::uint32_t first_triangle, std::uint32_t triangles,
-//                   std::uint32_t vertices, const DrawState&);
-template <class Observer>
-void draw_frame(StepScene& s, Framebuffer& fb, Observer& obs,
+// The state a mesh draws with, as SceneRenderer::render sets it.
+inline DrawState draw_state(const BoundMaterial& bm) {
+    DrawState st;
+    st.cull = bm.m->double_sided ? CullMode::None : CullMode::Back;
+    st.may_discard = bm.m->alpha_mode == AlphaMode::Mask;
+    return st;
+}
+
+// How the tile pass runs a draw of state `st` (Renderer::submit's choice,
+// for a colour target with a fragment program): its winners shaded once
+// after the visibility pass, or shaded in submission order.
+inline bool draws_visible(const DrawState& st, FrameOptions::Visibility v) {
+    return v != FrameOptions::Visibility::Never && st.depth_test && st.depth_write && st.blend == Blend::Replace &&
+           !st.may_discard;
+}
+
+// make_tap(mesh, first_triangle, triangles, vertices, state) gives the
+// observer of each draw (raster/observer.h), created before the frame runs;
+// the taps live until the frame is done. One frame: every mesh submitted,
+// then one tile pass (raster/frame.h), with the samples per pixel and the
+// visibility setting of s.settings; fb is resized by the caller.
+template <class MakeTap>
+void draw_frame(StepScene& s, Framebuffer& fb, MakeTap&& make_tap,
                 std::uint64_t triangle_limit = std::numeric_limits<std::uint64_t>::max()) {
+    using Tap = decltype(make_tap(0, 0u, 0u, 0u, DrawState{}));
+    std::vector<Tap> taps;
+    taps.reserve(s.scene.meshes.size());  // submit() keeps a pointer to each tap
     Renderer& renderer = *s.renderer;
-    renderer.clear(fb, 0.0f, 0.0f, 0.0f, 1.0f);
     renderer.begin_frame();
+    FrameOptions frame;  // cleared to black, alpha 1, depth 1, in the tile pass
+    frame.samples = s.settings.samples;
+    frame.visibility = s.settings.visibility;
+    renderer.begin(fb, frame);
     const ShadingContext ctx = shading_context(s.settings);
     const float aspect = float(fb.width) / float(fb.height);
     const glm::mat4 vp = s.settings.camera.view_projection(aspect);
@@ -50,6 +76,7 @@ void draw_frame(StepScene& s, Framebuffer& fb, Observer& obs,
     for (std::size_t m = 0; m < s.scene.meshes.size(); ++m) {
         const Mesh& mesh = s.scene.meshes[m];
         if (mesh.indices.empty()) continue;
+        if (first >= triangle_limit) break;
         const BoundMaterial& bm = draw_material(s, mesh);
         PbrProgram prog;
         prog.mesh = &mesh;
@@ -59,18 +86,16 @@ void draw_frame(StepScene& s, Framebuffer& fb, Observer& obs,
         prog.view = DebugView::None;
         prog.near_plane = s.settings.camera.near_plane;
         prog.far_plane = s.settings.camera.far_plane;
-        DrawState st;
-        st.cull = bm.m->double_sided ? CullMode::None : CullMode::Back;
+        const DrawState st = draw_state(bm);
         const std::uint64_t triangles = mesh.indices.size() / 3;
-        if (first >= triangle_limit) break;
         const std::uint64_t drawn = std::min<std::uint64_t>(triangles, triangle_limit - first);
-        if constexpr (Observer::enabled)
-            obs.begin_draw(int(m), std::uint32_t(first), std::uint32_t(triangles),
-                           std::uint32_t(mesh.positions.size()), st);
-        renderer.draw(fb, prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(),
-                      std::size_t(drawn) * 3, st, obs);
+        taps.push_back(make_tap(int(m), std::uint32_t(first), std::uint32_t(triangles),
+                                std::uint32_t(mesh.positions.size()), st));
+        renderer.submit(prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(), std::size_t(drawn) * 3, st,
+                        taps.back());
         first += triangles;
     }
+    renderer.end();
 }
 
 } // namespace prast::stepper

@@ -3,8 +3,9 @@
 // Kept compact: per draw the vertex stage's output; per triangle its fate and
 // per post-clip piece the TriangleSetup the pipeline built and the tiles it
 // was binned to; per tile, in the order the tile ran them, the 4x4 blocks
-// with their coverage, depth-test and written masks and the depths of the
-// covered pixels. Barycentrics, varyings and shading are recomputed on
+// with their coverage, depth-test, shaded and written masks, and sample by
+// sample (multisampling) the coverage and depth-test masks and the depths of
+// the covered samples. Barycentrics, varyings and shading are recomputed on
 // demand from these (replay.h), with the pipeline's own data and functions.
 //
 // Observer calls come from worker threads: vertex and triangle events are
@@ -23,6 +24,7 @@
 #include "raster/draw_state.h"
 #include "raster/framebuffer.h"
 #include "raster/observer.h"
+#include "raster/pipeline.h"
 #include "raster/setup.h"
 #include "raster/stats.h"
 #include "shading/pbr_program.h"
@@ -36,6 +38,7 @@ constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 struct DrawRecord {
     int mesh = -1;                      // index into the scene's meshes
     DrawState state;
+    bool visible = false;               // visibility pass (winners shaded once), else shaded in order
     std::uint32_t first_triangle = 0;   // global number of the draw's triangle 0
     std::uint32_t triangle_count = 0;
     std::uint32_t vertex_count = 0;
@@ -57,23 +60,31 @@ struct TriangleRecord {
     std::uint32_t first_piece = 0, piece_count = 0;
 };
 
-// One 4x4 block of one triangle piece in a tile: covered, passed the depth
-// test, written (passed and not discarded by the shader).
+// One 4x4 block of one triangle piece in a tile: covered (a lane counts when
+// any of its samples is), passed the depth test (any sample, at that point
+// of the tile's sequence), shaded (the lanes the fragment program ran for:
+// all that passed when shaded in order, only the lanes where the triangle
+// finally won a sample when shaded after the visibility pass) and written
+// (shaded and not discarded).
 struct BlockRecord {
     std::uint32_t piece = 0;            // index into Recording::pieces
     std::uint16_t bx = 0, by = 0;       // top-left pixel
-    std::uint16_t mask = 0, pass = 0, live = 0;
-    std::uint32_t z = 0;                // first covered lane's depth in TileRecord::z (lane order)
+    std::uint16_t mask = 0, pass = 0, shaded = 0, live = 0;
+    std::uint32_t z = 0;                // first depth in TileRecord::z: sample by sample, covered lanes in lane order
+    std::uint32_t masks = 0;            // several samples: first of its 2 x samples masks in TileRecord::masks
 };
 
 struct TileRecord {
     std::vector<std::uint32_t> pieces;  // binned pieces, in the order the tile ran them
     std::vector<BlockRecord> blocks;    // in the order the tile ran them
-    std::vector<float> z;               // window depth of each covered lane of each block
+    std::vector<float> z;               // window depth of each covered sample of each block
+    std::vector<std::uint16_t> masks;   // several samples: per block cover[0..S-1], pass[0..S-1]
 };
 
 struct Recording {
     int width = 0, height = 0, tile_size = 0, tiles_x = 0, tiles_y = 0;
+    int samples = 1;                        // per pixel
+    FrameOptions::Visibility visibility = FrameOptions::Visibility::Auto;
     std::vector<DrawRecord> draws;
     std::vector<TriangleRecord> triangles;  // global submission order
     std::vector<PieceRecord> pieces;        // grouped by triangle, pieces in fan order
@@ -89,6 +100,20 @@ struct Recording {
     const DrawRecord& draw_of(std::uint32_t tri) const;
     std::uint32_t triangle_count() const { return std::uint32_t(triangles.size()); }
     std::size_t bytes() const;              // memory held, without the framebuffer
+
+    // Sample s of a recorded block: its coverage and depth-test masks, and
+    // the depth of a covered lane.
+    std::uint32_t cover(const TileRecord& t, const BlockRecord& b, int s) const {
+        return samples == 1 ? b.mask : t.masks[b.masks + std::size_t(s)];
+    }
+    std::uint32_t pass(const TileRecord& t, const BlockRecord& b, int s) const {
+        return samples == 1 ? b.pass : t.masks[b.masks + std::size_t(samples + s)];
+    }
+    float depth(const TileRecord& t, const BlockRecord& b, int s, int lane) const {
+        std::size_t k = b.z;
+        for (int i = 0; i < s; ++i) k += std::size_t(__builtin_popcount(cover(t, b, i)));
+        return t.z[k + std::size_t(__builtin_popcount(cover(t, b, s) & ((1u << lane) - 1u)))];
+    }
 };
 
 // Draws the frame with a recording observer; `rec` is filled.

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "raster/samples.h"
+#include "raster/shade.h"
 #include "stepper/frame_loop.h"
 
 namespace prast::stepper {
@@ -80,35 +82,60 @@ void replay_block(const StepScene& s, const Recording& rec, const BlockRecord& b
     float v[3][kStride];
     piece_vertices(s, rec, b.piece, v);
     constexpr int NV = kPbrVaryings;
-    float v0[NV], d1[NV], d2[NV];
+    detail::TriangleVaryings<NV> pv;  // as prepare_varyings() makes them
     for (int k = 0; k < NV; ++k) {
-        v0[k] = v[0][4 + k];
-        d1[k] = v[1][4 + k] - v[0][4 + k];
-        d2[k] = v[2][4 + k] - v[0][4 + k];
+        pv.v0[k] = v[0][4 + k];
+        pv.d1[k] = v[1][4 + k] - v[0][4 + k];
+        pv.d2[k] = v[2][4 + k] - v[0][4 + k];
     }
     FragmentBlock<NV>& in = out.in;
-    const float ox = float(int(b.bx) - t.minx), oy = float(int(b.by) - t.miny);
+    const SamplePattern& sp = sample_pattern(rec.samples);
+    const std::uint32_t lanes = b.shaded ? b.shaded : b.pass;  // the lanes the shader ran for
+    // The rasterizer's own interpolation (shade.h), centroids included.
+    if (rec.samples > 1) detail::interpolate_block<true, NV>(t, pv, sp, b.bx, b.by, lanes, nullptr, in);
+    else detail::interpolate_block<false, NV>(t, pv, sp, b.bx, b.by, lanes, nullptr, in);
+    in.x = b.bx;
+    in.y = b.by;
+    in.mask = lanes;
+    in.prim_id = t.prim_id;
+    in.front_facing = t.front_facing;
+
+    // For display: the point each lane was interpolated at, its barycentrics
+    // and perspective weights, with interpolate_block()'s float operations.
     for (int l = 0; l < kBlockLanes; ++l) {
-        // Screen-space barycentrics from the anchored planes, then depth.
-        const float dx = ox + float(lane_x(l)), dy = oy + float(lane_y(l));
+        const int x = b.bx + lane_x(l), y = b.by + lane_y(l);
+        float dx = float(b.bx - t.ax) + float(lane_x(l)), dy = float(b.by - t.ay) + float(lane_y(l));
+        out.at_x[l] = out.at_y[l] = 0.0f;
+        out.centroid_of[l] = 0;
+        if ((in.centroid_mask >> l) & 1u) {
+            float sum_x = 0.0f, sum_y = 0.0f;
+            int n = 0;
+            for (int smp = 0; smp < sp.count; ++smp) {
+                bool inside = true;
+                for (int e = 0; e < 3; ++e)
+                    inside &= edge_at_pixel(t, e, x, y) + std::int64_t(t.A[e]) * sp.fixed_x(smp) +
+                                  std::int64_t(t.B[e]) * sp.fixed_y(smp) >= 0;
+                if (!inside) continue;
+                sum_x += sp.pixel_x(smp);
+                sum_y += sp.pixel_y(smp);
+                out.centroid_of[l] |= std::uint8_t(1u << smp);
+                ++n;
+            }
+            if (n > 0) {
+                out.at_x[l] = sum_x / float(n);
+                out.at_y[l] = sum_y / float(n);
+                dx = float(x - t.ax) + out.at_x[l];
+                dy = float(y - t.ay) + out.at_y[l];
+            }
+        }
         const float b0 = t.bary[0][0] + t.bary[0][1] * dx + t.bary[0][2] * dy;
         const float b1 = t.bary[1][0] + t.bary[1][1] * dx + t.bary[1][2] * dy;
         const float b2 = t.bary[2][0] + t.bary[2][1] * dx + t.bary[2][2] * dy;
-        const float z = b0 * t.z[0] + b1 * t.z[1] + b2 * t.z[2];
-        in.z[l] = std::min(std::max(z, 0.0f), 1.0f);
         out.bary[0][l] = b0; out.bary[1][l] = b1; out.bary[2][l] = b2;
-        // Perspective-correct weights: over w, renormalised; then the varyings.
         const float q0 = b0 * t.inv_w[0], q1 = b1 * t.inv_w[1], q2 = b2 * t.inv_w[2];
         const float sum = 1.0f / (q0 + q1 + q2);
-        const float w1 = q1 * sum, w2 = q2 * sum;
-        out.persp[0][l] = q0 * sum; out.persp[1][l] = w1; out.persp[2][l] = w2;
-        for (int k = 0; k < NV; ++k) in.var[k][l] = v0[k] + w1 * d1[k] + w2 * d2[k];
+        out.persp[0][l] = q0 * sum; out.persp[1][l] = q1 * sum; out.persp[2][l] = q2 * sum;
     }
-    in.x = b.bx;
-    in.y = b.by;
-    in.mask = b.pass;
-    in.prim_id = t.prim_id;
-    in.front_facing = t.front_facing;
 }
 
 LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const ReplayedBlock& rb, int lane) {

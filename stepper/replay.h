@@ -42,11 +42,17 @@ struct SnappedVertex {
 };
 SnappedVertex snap_vertex(const float* clip, int width, int height);
 
-// The fragment block of a recorded block as the shader received it.
+// The fragment block of a recorded block as the shader received it (filled
+// by the rasterizer's own interpolate_block()), and for display where each
+// lane was interpolated: at its pixel centre, or with several samples, for a
+// shaded lane whose centre is outside the triangle, at the centroid of its
+// covered samples.
 struct ReplayedBlock {
     FragmentBlock<kPbrVaryings> in;
-    float bary[3][kBlockLanes];         // screen-space barycentrics
+    float bary[3][kBlockLanes];         // screen-space barycentrics at that point
     float persp[3][kBlockLanes];        // perspective-correct weights (w0 = q0 / sum, shown only)
+    float at_x[kBlockLanes], at_y[kBlockLanes];  // the point, in pixels from the pixel centre
+    std::uint8_t centroid_of[kBlockLanes];       // bit s: sample s in the centroid; 0: the centre
 };
 void replay_block(const StepScene& s, const Recording& rec, const BlockRecord& b, ReplayedBlock& out);
 

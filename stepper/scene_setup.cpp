@@ -70,6 +70,7 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     s.ambient = opt.ambient;
     s.model = opt.brdf;
     s.view = DebugView::None;
+    s.samples = opt.samples;
 
     // Frame 0 of render's turntable loop.
     Camera cam = camera;

@@ -34,6 +34,7 @@ struct FrameRequest {
     ToneMap tonemap = ToneMap::Aces;         // render's effective tone map
     int threads = 0;
     int tile_size = kDefaultTileSize;
+    int samples = 1;                         // per pixel (render's --msaa)
 };
 
 // A scene ready to draw: loaded, framed, lit, its textures bound.
@@ -46,6 +47,7 @@ struct StepScene {
     std::vector<std::string> notes;  // warnings and the default-rig note, for stderr
     int width() const { return options.width; }
     int height() const { return options.height; }
+    int samples() const { return options.samples; }
     float exposure() const { return options.exposure; }
     ToneMap tonemap() const { return options.tonemap; }
 };

@@ -59,40 +59,79 @@ std::string count_range(long n) { return n > 0 ? "0.." + std::to_string(n - 1) :
 // same order, and the values the stepper recomputes equal to the pipeline's.
 class VerifyObserver {
 public:
-    static constexpr bool enabled = true;
-
     VerifyObserver(const StepScene& s, const Recording& rec)
         : s_(s), rec_(rec), ctx_(shading_context(s.settings)), cursor_(rec.tiles.size(), 0) {}
 
-    void begin_draw(int, std::uint32_t, std::uint32_t, std::uint32_t, const DrawState&) { ++draw_; }
+    // The observer of one draw.
+    struct Tap {
+        static constexpr bool enabled = true;
+        VerifyObserver* v;
+        std::size_t draw;
+        void vertex(std::uint32_t i, const float* clip, const float* var, int nv) { v->vertex(draw, i, clip, var, nv); }
+        void triangle(std::uint32_t, TriangleFate, bool, const TriangleSetup*) {}
+        void binned(std::uint32_t, int) {}
+        void fragments(std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass, const float*) {
+            v->fragments(draw, prim, bx, by, mask, pass);
+        }
+        void samples(std::uint32_t, int bx, int by, const SampleCoverage& sc) { v->samples(bx, by, sc); }
+        template <int NV>
+        void shaded(const FragmentBlock<NV>& in, const FragmentOut& out, std::uint32_t live) {
+            v->shaded(draw, in, out, live);
+        }
+    };
+    Tap tap() { return Tap{this, draws_++}; }
 
-    void vertex(std::uint32_t v, const float* clip, const float* var, int nv) {
-        const float* r = &rec_.draws[std::size_t(draw_ - 1)].vertices[std::size_t(v) * kStride];
+    void vertex(std::size_t draw, std::uint32_t v, const float* clip, const float* var, int nv) {
+        const float* r = &rec_.draws[draw].vertices[std::size_t(v) * kStride];
         ++vertices_;
         if (std::memcmp(r, clip, 4 * sizeof(float)) || std::memcmp(r + 4, var, std::size_t(nv) * sizeof(float)))
-            fail("vertex " + std::to_string(v) + " of draw " + std::to_string(draw_ - 1) + " differs");
+            fail("vertex " + std::to_string(v) + " of draw " + std::to_string(draw) + " differs");
     }
-    void triangle(std::uint32_t, TriangleFate, bool, const TriangleSetup*) {}
-    void binned(std::uint32_t, int) {}
 
-    void fragments(std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass, const float* z) {
+    void fragments(std::size_t draw, std::uint32_t prim, int bx, int by, std::uint32_t mask, std::uint32_t pass) {
         const std::size_t tile = std::size_t(rec_.tile_of(bx, by));
         const TileRecord& t = rec_.tiles[tile];
         ++blocks_;
         if (cursor_[tile] >= t.blocks.size()) return fail("tile " + std::to_string(tile) + " has more blocks");
         const BlockRecord& b = t.blocks[cursor_[tile]++];
-        const std::uint32_t tri = rec_.draws[std::size_t(draw_ - 1)].first_triangle + prim;
-        bool same = b.bx == bx && b.by == by && b.mask == mask && b.pass == pass && rec_.pieces[b.piece].triangle == tri;
-        std::size_t k = b.z;
-        for (std::uint32_t m = mask; m && same; m &= m - 1) same = t.z[k++] == z[__builtin_ctz(m)];
-        if (!same) fail("block " + std::to_string(bx) + "," + std::to_string(by) + " of tri " + std::to_string(tri) +
-                        " differs from the recording");
+        const std::uint32_t tri = rec_.draws[draw].first_triangle + prim;
+        if (!(b.bx == bx && b.by == by && b.mask == mask && b.pass == pass && rec_.pieces[b.piece].triangle == tri))
+            fail("block " + std::to_string(bx) + "," + std::to_string(by) + " of tri " + std::to_string(tri) +
+                 " differs from the recording");
+    }
+
+    // Right after fragments(): the block's samples against the recording.
+    void samples(int bx, int by, const SampleCoverage& sc) {
+        const std::size_t tile = std::size_t(rec_.tile_of(bx, by));
+        const TileRecord& t = rec_.tiles[tile];
+        if (cursor_[tile] == 0 || cursor_[tile] > t.blocks.size()) return;
+        const BlockRecord& b = t.blocks[cursor_[tile] - 1];
+        bool same = sc.count == rec_.samples;
+        for (int s = 0; s < sc.count && same; ++s) {
+            same = rec_.cover(t, b, s) == (sc.cover[s] & 0xFFFFu) && rec_.pass(t, b, s) == (sc.pass[s] & 0xFFFFu);
+            for (std::uint32_t m = sc.cover[s] & 0xFFFFu; m && same; m &= m - 1) {
+                const int l = __builtin_ctz(m);
+                same = rec_.depth(t, b, s, l) == sc.z[s][l];
+            }
+            samples_ += std::uint64_t(__builtin_popcount(sc.cover[s] & 0xFFFFu));
+        }
+        if (!same) fail("block " + std::to_string(bx) + "," + std::to_string(by) +
+                        ": sample coverage, depth tests or depths differ from the recording");
     }
 
     template <int NV>
-    void shaded(const FragmentBlock<NV>& in, const FragmentOut& out, std::uint32_t live) {
+    void shaded(std::size_t draw, const FragmentBlock<NV>& in, const FragmentOut& out, std::uint32_t live) {
+        // The recorded block of this (block, triangle): shading may come
+        // right after fragments() or later in the tile (visibility pass).
         const std::size_t tile = std::size_t(rec_.tile_of(in.x, in.y));
-        const BlockRecord& b = rec_.tiles[tile].blocks[cursor_[tile] - 1];
+        const std::vector<BlockRecord>& blocks = rec_.tiles[tile].blocks;
+        const std::uint32_t tri = rec_.draws[draw].first_triangle + in.prim_id;
+        std::size_t i = cursor_[tile];
+        while (i > 0 && !(blocks[i - 1].bx == in.x && blocks[i - 1].by == in.y &&
+                          rec_.pieces[blocks[i - 1].piece].triangle == tri && blocks[i - 1].shaded == in.mask))
+            --i;
+        if (i == 0) return fail("a shaded block the recording does not have");
+        const BlockRecord& b = blocks[i - 1];
         ReplayedBlock rb;
         replay_block(s_, rec_, b, rb);
         ++shaded_blocks_;
@@ -100,8 +139,11 @@ public:
                                   std::to_string(rec_.pieces[b.piece].triangle);
         if (live != b.live) fail(where + ": written lanes differ");
         if (std::memcmp(rb.in.var, in.var, sizeof in.var) || std::memcmp(rb.in.z, in.z, sizeof in.z) ||
-            rb.in.mask != in.mask || rb.in.front_facing != in.front_facing || rb.in.prim_id != in.prim_id)
+            rb.in.mask != in.mask || rb.in.front_facing != in.front_facing || rb.in.prim_id != in.prim_id ||
+            rb.in.centroid_mask != in.centroid_mask ||
+            (in.centroid_mask && std::memcmp(rb.in.centre_var, in.centre_var, sizeof in.centre_var)))
             fail(where + ": recomputed varyings or depths differ from the rasterizer's");
+        centroid_lanes_ += std::uint64_t(__builtin_popcount(in.centroid_mask));
         const BoundMaterial& bm = material_of(s_, rec_, rec_.pieces[b.piece].triangle);
         for (std::uint32_t m = live; m; m &= m - 1) {
             const int l = __builtin_ctz(m);
@@ -123,8 +165,8 @@ public:
     const Recording& rec_;
     const ShadingContext ctx_;
     std::vector<std::size_t> cursor_;
-    int draw_ = 0;
-    std::atomic<std::uint64_t> vertices_{0}, blocks_{0}, shaded_blocks_{0}, pixels_{0};
+    std::size_t draws_ = 0;
+    std::atomic<std::uint64_t> vertices_{0}, blocks_{0}, samples_{0}, shaded_blocks_{0}, pixels_{0}, centroid_lanes_{0};
     std::mutex mutex_;
     std::uint64_t failures_ = 0;
     std::string first_;
@@ -267,7 +309,7 @@ std::vector<std::uint8_t> Session::upto_png(std::uint64_t triangles) {
 Reply Session::verify() {
     VerifyObserver obs(s_, rec_);
     Framebuffer fb(rec_.width, rec_.height);
-    draw_frame(s_, fb, obs);
+    draw_frame(s_, fb, [&](int, std::uint32_t, std::uint32_t, std::uint32_t, const DrawState&) { return obs.tap(); });
     for (std::size_t t = 0; t < rec_.tiles.size(); ++t)
         if (obs.cursor_[t] != rec_.tiles[t].blocks.size()) obs.fail("tile " + std::to_string(t) + " has fewer blocks");
     if (std::memcmp(fb.color.data(), rec_.fb.color.data(), fb.color.size() * sizeof(float)) ||
@@ -280,8 +322,10 @@ Reply Session::verify() {
     std::ostringstream o;
     o << "verify: re-rendered the frame and compared it with the recording\n"
       << "  " << obs.vertices_ << " vertices: clip coordinates and varyings\n"
-      << "  " << obs.blocks_ << " blocks: coverage, depth-test masks and depths, in each tile's order\n"
-      << "  " << obs.shaded_blocks_ << " shaded blocks: recomputed barycentrics, depths and varyings of all 16 lanes\n"
+      << "  " << obs.blocks_ << " blocks: coverage and depth-test masks, in each tile's order\n"
+      << "  " << obs.samples_ << " covered samples (" << rec_.samples << " per pixel): coverage, depth test, depth\n"
+      << "  " << obs.shaded_blocks_ << " shaded blocks: recomputed barycentrics, depths and varyings of all 16 lanes ("
+      << obs.centroid_lanes_ << " lanes at a centroid)\n"
       << "  " << obs.pixels_ << " written pixels: recomputed shading (scalar path) against the shader's output\n"
       << "  the framebuffer against the recording's and SceneRenderer::render's\n";
     if (obs.failures_) {

@@ -32,6 +32,14 @@ const std::vector<StageInfo>& stage_list() {
         {"overdraw", "Overdraw",
          "Fragments covered per pixel, before the depth test: black 0, blue 1, green 2, yellow 3, red 4, then "
          "magenta to white for 8 or more."},
+        {"shaded", "Shaded once (the visibility pass)",
+         "Fragment-program runs per pixel, same colours as overdraw: the visibility pass depth-tests every "
+         "fragment first and shades only each sample's final winner, so where overdraw shows 3 this is mostly 1 "
+         "(2 or more along edges, where several triangles keep samples of one pixel)."},
+        {"msaa", "Samples (MSAA): fragments per pixel",
+         "How many fragments the resolve averages in each pixel: dark grey one (an interior pixel, all samples "
+         "alike), orange two, red three or more; blue and cyan when the background keeps some samples. Black: "
+         "the background alone. With --msaa 1 every pixel has one."},
         {"quad_overdraw", "Quad overdraw (helper lanes)",
          "Lanes the fragment shader ran per pixel, counting helper lanes: a 2x2 quad with any live pixel shades "
          "all four. Same colours as overdraw; edges of small triangles light up."},
@@ -211,17 +219,19 @@ void draw_depth(const StepScene& s, const Recording& rec, Image& img) {
         }
 }
 
-// Per pixel counts over the recorded blocks: covered lanes, or lanes of shaded quads.
-void draw_counts(const Recording& rec, Image& img, bool quads) {
+// Per pixel counts over the recorded blocks: covered lanes, lanes the
+// fragment program ran for, or lanes of shaded quads.
+enum class Count { Covered, Shaded, Quads };
+void draw_counts(const Recording& rec, Image& img, Count what) {
     fill(img, rec, 0);
     std::vector<int> count(std::size_t(rec.width) * rec.height, 0);
     for (const TileRecord& t : rec.tiles)
         for (const BlockRecord& b : t.blocks) {
-            std::uint32_t m = b.mask;
-            if (quads) {
+            std::uint32_t m = what == Count::Shaded ? b.shaded : b.mask;
+            if (what == Count::Quads) {
                 m = 0;
                 for (int q = 0; q < 4; ++q)
-                    if ((b.pass >> (4 * q)) & 0xFu) m |= 0xFu << (4 * q);
+                    if ((b.shaded >> (4 * q)) & 0xFu) m |= 0xFu << (4 * q);
             }
             for (; m; m &= m - 1) {
                 const int l = __builtin_ctz(m);
@@ -233,21 +243,112 @@ void draw_counts(const Recording& rec, Image& img, bool quads) {
         for (int x = 0; x < rec.width; ++x) put(img, rec, x, y, heat(count[std::size_t(y) * rec.width + x]));
 }
 
-// The last written block of every pixel, per tile, in the tile's order.
-template <class Fn>
-void for_each_winner(const Recording& rec, const TileRecord& t, Fn&& fn) {
+// The fragments whose colour each sample of a tile ends the frame with,
+// replayed as the tile pass ran (explain_pixel() does the same for one
+// pixel): a draw taking the visibility pass makes each sample it passes its
+// winner; a draw shaded in order makes the samples it writes its own.
+struct TileOwners {
+    int x0 = 0, y0 = 0, size = 0, samples = 1;
+    std::vector<std::int32_t> owner;  // block index in the tile, -1 cleared; [(py * size + px) * samples + s]
+
+    std::int32_t at(int x, int y, int s) const {
+        return owner[(std::size_t(y - y0) * std::size_t(size) + std::size_t(x - x0)) * std::size_t(samples) + std::size_t(s)];
+    }
+    // The fragment holding most of the pixel's samples (the earliest on a
+    // tie): the first "shading of" of `pixel X Y`. -1 for the background.
+    std::int32_t main(int x, int y) const {
+        std::int32_t best = -1;
+        int best_n = 0;
+        for (int s = 0; s < samples; ++s) {
+            const std::int32_t o = at(x, y, s);
+            if (o < 0) continue;
+            int n = 0;
+            for (int k = 0; k < samples; ++k) n += at(x, y, k) == o;
+            if (n > best_n || (n == best_n && o < best)) {
+                best = o;
+                best_n = n;
+            }
+        }
+        return best;
+    }
+    int distinct(int x, int y) const {
+        int n = 0;
+        for (int s = 0; s < samples; ++s) {
+            const std::int32_t o = at(x, y, s);
+            bool seen = false;
+            for (int k = 0; k < s; ++k) seen |= at(x, y, k) == o;
+            n += !seen;
+        }
+        return n;
+    }
+};
+
+TileOwners tile_owners(const Recording& rec, int tile) {
+    TileOwners o;
+    o.size = rec.tile_size;
+    o.samples = rec.samples;
+    o.x0 = (tile % rec.tiles_x) * rec.tile_size;
+    o.y0 = (tile / rec.tiles_x) * rec.tile_size;
+    o.owner.assign(std::size_t(o.size) * std::size_t(o.size) * std::size_t(o.samples), -1);
+    const TileRecord& t = rec.tiles[std::size_t(tile)];
     for (std::size_t i = 0; i < t.blocks.size(); ++i) {
         const BlockRecord& b = t.blocks[i];
-        for (std::uint32_t m = b.live; m; m &= m - 1) fn(i, __builtin_ctz(m));
+        const bool visible = rec.draw_of(rec.pieces[b.piece].triangle).visible;
+        for (int s = 0; s < rec.samples; ++s) {
+            std::uint32_t m = rec.pass(t, b, s);
+            if (!visible) m &= b.live;
+            for (; m; m &= m - 1) {
+                const int l = __builtin_ctz(m);
+                const std::size_t p = std::size_t(b.by + lane_y(l) - o.y0) * std::size_t(o.size) +
+                                      std::size_t(b.bx + lane_x(l) - o.x0);
+                o.owner[p * std::size_t(o.samples) + std::size_t(s)] = std::int32_t(i);
+            }
+        }
     }
-    (void)rec;
+    return o;
+}
+
+// Calls fn(block index, lane) for the main fragment of every pixel of the tile.
+template <class Fn>
+void for_each_winner(const Recording& rec, int tile, Fn&& fn) {
+    const TileOwners o = tile_owners(rec, tile);
+    const int x1 = std::min(o.x0 + o.size, rec.width), y1 = std::min(o.y0 + o.size, rec.height);
+    for (int y = o.y0; y < y1; ++y)
+        for (int x = o.x0; x < x1; ++x) {
+            const std::int32_t b = o.main(x, y);
+            if (b < 0) continue;
+            int lane = 0;
+            for (int l = 0; l < kBlockLanes; ++l)
+                if (lane_x(l) == (x & 3) && lane_y(l) == (y & 3)) lane = l;
+            fn(std::size_t(b), lane);
+        }
+}
+
+// Per pixel: how many fragments (and the background) the resolve averages.
+void draw_msaa(const Recording& rec, Image& img) {
+    fill(img, rec, 0);
+    for (int tile = 0; tile < int(rec.tiles.size()); ++tile) {
+        const TileOwners o = tile_owners(rec, tile);
+        const int x1 = std::min(o.x0 + o.size, rec.width), y1 = std::min(o.y0 + o.size, rec.height);
+        for (int y = o.y0; y < y1; ++y)
+            for (int x = o.x0; x < x1; ++x) {
+                bool background = false;
+                for (int s = 0; s < o.samples; ++s) background |= o.at(x, y, s) < 0;
+                const int n = o.distinct(x, y);
+                glm::vec3 c(0.0f);
+                if (n == 1 && !background) c = glm::vec3(0.3f);
+                else if (n == 2) c = background ? glm::vec3(0.1f, 0.4f, 1.0f) : glm::vec3(1.0f, 0.6f, 0.1f);
+                else if (n >= 3) c = background ? glm::vec3(0.2f, 1.0f, 1.0f) : glm::vec3(1.0f, 0.1f, 0.1f);
+                put(img, rec, x, y, c);
+            }
+    }
 }
 
 void draw_triangle_size(const Recording& rec, Image& img) {
     fill(img, rec, 0);
-    for (const TileRecord& t : rec.tiles)
-        for_each_winner(rec, t, [&](std::size_t i, int lane) {
-            const BlockRecord& b = t.blocks[i];
+    for (int tile = 0; tile < int(rec.tiles.size()); ++tile)
+        for_each_winner(rec, tile, [&](std::size_t i, int lane) {
+            const BlockRecord& b = rec.tiles[std::size_t(tile)].blocks[i];
             const TriangleSetup& s = rec.setups[rec.pieces[b.piece].setup];
             // 2 x area = |A0 B1 - A1 B0| / 65536 px^2, from the edge coefficients.
             const double area2 = std::fabs(double(s.A[0]) * double(s.B[1]) - double(s.A[1]) * double(s.B[0]));
@@ -340,8 +441,10 @@ void draw_stages(StepScene& s, const Recording& rec, const std::vector<std::stri
         else if (n == "wireframe") draw_wireframe(s, rec, img);
         else if (n == "bins") draw_bins(rec, img);
         else if (n == "depth") draw_depth(s, rec, img);
-        else if (n == "overdraw") draw_counts(rec, img, false);
-        else if (n == "quad_overdraw") draw_counts(rec, img, true);
+        else if (n == "overdraw") draw_counts(rec, img, Count::Covered);
+        else if (n == "shaded") draw_counts(rec, img, Count::Shaded);
+        else if (n == "quad_overdraw") draw_counts(rec, img, Count::Quads);
+        else if (n == "msaa") draw_msaa(rec, img);
         else if (n == "triangle_size") draw_triangle_size(rec, img);
         else if (n == "nan") draw_nan(rec, img);
         else if (n == "final") draw_final(s, rec, img);
@@ -359,7 +462,7 @@ void draw_stages(StepScene& s, const Recording& rec, const std::vector<std::stri
         const int ts = rec.tile_size;
         const int x0 = (tile % rec.tiles_x) * ts, y0 = (tile / rec.tiles_x) * ts;
         std::vector<std::int32_t> winner(std::size_t(ts) * ts * 2, -1);  // block index, lane
-        for_each_winner(rec, t, [&](std::size_t i, int lane) {
+        for_each_winner(rec, tile, [&](std::size_t i, int lane) {
             const BlockRecord& b = t.blocks[i];
             const std::size_t p = std::size_t(b.by + lane_y(lane) - y0) * ts + std::size_t(b.bx + lane_x(lane) - x0);
             winner[2 * p] = std::int32_t(i);

@@ -92,7 +92,8 @@ void check_stats_invariants(const FrameStats& s) {
     CHECK(s.fragments_written == s.fragments_covered - s.fragments_depth_killed - s.fragments_shader_killed);
     CHECK(s.fragments_covered <= s.blocks_rasterized * 16);
     CHECK(s.quads_shaded <= s.blocks_rasterized * 4);
-    CHECK(s.fragments_written <= s.quads_shaded * 4);
+    CHECK(s.fragments_shaded <= s.quads_shaded * 4);
+    CHECK(s.fragments_shaded <= s.fragments_written + s.fragments_shader_killed);
     CHECK(s.triangles_invalid + s.triangles_culled_frustum <= s.triangles_in);
 }
 
@@ -1756,7 +1757,10 @@ TEST_CASE("observer: every pixel sees its triangles in submission order, whateve
             for (std::size_t i = 1; i < prims.size(); ++i) out_of_order += prims[i] < prims[i - 1];
         CHECK(out_of_order == 0);
         CHECK(obs.fragment_total == r.stats().fragments_covered);
-        CHECK(obs.live_total == r.stats().fragments_written);
+        // Through the visibility pass only each pixel's winner is shaded.
+        CHECK(obs.live_total == r.stats().fragments_shaded);
+        CHECK(obs.live_total < r.stats().fragments_written);
+        CHECK(obs.live_total <= std::uint64_t(W) * H);
         CHECK(obs.pass_total == r.stats().fragments_covered - r.stats().fragments_depth_killed);
         std::uint64_t entries = 0, setups = 0;
         for (const auto& ts : obs.tiles) entries += ts.size();

@@ -174,6 +174,8 @@ void check_material(std::uint32_t seed) {
                                 &bm.normal, &bm.occlusion, &bm.emissive};
     for (int i = 0; i < 7; ++i)
         if (coin(rng)) *slots[i] = &textures[std::size_t(i)];
+    // glTF's occlusion often lives in R of the metal-roughness map: one texture bound twice.
+    if (bm.metallic_roughness && coin(rng)) bm.occlusion = bm.metallic_roughness;
 
     // A block of surface points; a few lanes with degenerate normals or
     // tangents exercise the fallbacks.

@@ -10,6 +10,7 @@
 //   PRAST_STEP_REGENERATE=1 build/prast_tests -ts=step
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -194,8 +195,16 @@ TEST_CASE("pixel: NormalTangentTest's explained pixels are render's") {
     CHECK(check_pixels_against_render(kNormalTangentFlags, 10, 8) > 30);
 }
 
+TEST_CASE("pixel: with 1 and 8 samples per pixel too, the explained pixels are render's") {
+    for (const char* msaa : {"1", "8"}) {
+        INFO("--msaa " << msaa);
+        CHECK(check_pixels_against_render({"--size", "480x270", "--msaa", msaa}, 16, 9) > 60);
+    }
+}
+
 TEST_CASE("verify: every recomputed number equals the pipeline's") {
-    std::vector<std::vector<std::string>> scenes = {{}, {"--near", "6.5", "--far", "20"}};
+    std::vector<std::vector<std::string>> scenes = {{}, {"--near", "6.5", "--far", "20"}, {"--msaa", "1"},
+                                                    {"--msaa", "8", "--size", "640x360"}};
     if (have_asset(kTea)) scenes.push_back(kTeaFlags);
     if (have_asset(kNormalTangent)) scenes.push_back(kNormalTangentFlags);
     for (const auto& flags : scenes) {
@@ -228,7 +237,8 @@ TEST_CASE("--out: every stage as a PNG and an index.html; the final stage is ren
     const CliRun r = box.run_exe(kStep, {"--size", "320x180", "--out", "stages"});
     REQUIRE(r.code == 0);
     const std::string index = read_text(box.work() / "stages" / "index.html");
-    const char* kStages[] = {"vertices", "wireframe", "bins", "depth", "overdraw", "quad_overdraw", "triangle_size",
+    const char* kStages[] = {"vertices", "wireframe", "bins", "depth", "overdraw", "shaded", "msaa", "quad_overdraw",
+                             "triangle_size",
                              "nan", "albedo", "normal", "roughness", "metallic", "occlusion", "mip", "D", "F", "G",
                              "diffuse", "specular", "final"};
     for (const char* name : kStages) {
@@ -271,6 +281,10 @@ TEST_CASE("sessions: a near plane through the scene clips triangles") {
     check_transcript("clipped", {"--near", "6.5", "--far", "20"});
 }
 
+TEST_CASE("sessions: spheres in front of spheres, the visibility pass and the samples") {
+    check_transcript("side", {"--size", "320x180", "--eye", "8,2.2,0.6", "--target", "0,1.9,0"});
+}
+
 TEST_CASE("sessions: bad commands get one line each and the session goes on") {
     CliSandbox box;
     const std::string long_word(5000, 'x');
@@ -310,6 +324,45 @@ TEST_CASE("flags: render's flags that make no sense for one frame, and bad files
     const CliRun pixel = box.run_exe(kStep, {"--size", "160x90", "--pixel", "80,60"});
     CHECK(pixel.code == 0);
     CHECK(pixel_answers(pixel.out).size() == 1);
+}
+
+} // TEST_SUITE
+
+TEST_SUITE("readme") {
+
+// The README's first paragraph names what scripts/install-deps.sh installs:
+// the same packages, so a reader who installs by hand gets a working build.
+TEST_CASE("README: the install paragraph lists exactly the packages of scripts/install-deps.sh") {
+    const std::string readme = read_text(std::string(PRAST_SOURCE_DIR) + "/README.md");
+    const std::string script = read_text(std::string(PRAST_SOURCE_DIR) + "/scripts/install-deps.sh");
+    auto words = [](const std::string& text) {
+        std::vector<std::string> out;
+        std::string w;
+        for (char c : text + " ") {
+            if (c == ' ' || c == '\n' || c == '`' || c == '\t') {
+                if (!w.empty()) out.push_back(w);
+                w.clear();
+            } else {
+                w += c;
+            }
+        }
+        return out;
+    };
+    // The script: the words between PACKAGES=" and the closing quote.
+    const std::size_t a = script.find("PACKAGES=\"");
+    REQUIRE(a != std::string::npos);
+    const std::size_t b = script.find('"', a + 10);
+    REQUIRE(b != std::string::npos);
+    std::vector<std::string> want = words(script.substr(a + 10, b - a - 10));
+    // The README: the words after "it installs" up to the sentence's end.
+    const std::size_t c = readme.find("it installs ");
+    REQUIRE(c != std::string::npos);
+    const std::size_t d = readme.find('.', c);
+    std::vector<std::string> got = words(readme.substr(c + 12, d - c - 12));
+    std::sort(want.begin(), want.end());
+    std::sort(got.begin(), got.end());
+    CHECK(want.size() >= 12);
+    CHECK(got == want);
 }
 
 } // TEST_SUITE

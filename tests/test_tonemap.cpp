@@ -1,15 +1,21 @@
 // Tone mapping tests: the operators' known values and shapes, and the 8-bit
-// resolve against hand-computed bytes and against the per-pixel reference.
+// resolve against hand-computed bytes and against the per-pixel reference;
+// the vectorised resolve on every special value and at every sRGB threshold;
+// the tile-pass resolve of a frame against the whole-image resolve.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "scene/default_scene.h"
 #include "shading/color.h"
+#include "shading/resolve.h"
+#include "shading/scene_renderer.h"
 #include "shading/tonemap.h"
 
 using namespace prast;
@@ -21,6 +27,22 @@ glm::vec3 neutral(glm::vec3 c) { return tonemap(c, ToneMap::Neutral); }
 
 void check_near(glm::vec3 a, glm::vec3 b, double eps) {
     for (int i = 0; i < 3; ++i) CHECK(a[i] == doctest::Approx(b[i]).epsilon(eps));
+}
+
+// The per-pixel reference: tonemap(), then linear_to_srgb8() (std::pow),
+// alpha clamped and rounded.
+void reference_pixel(const float* c, float exposure, ToneMap tm, std::uint8_t* out) {
+    const glm::vec3 m = tonemap(glm::vec3(c[0], c[1], c[2]) * exposure, tm);
+    for (int k = 0; k < 3; ++k) out[k] = linear_to_srgb8(m[k]);
+    float a = c[3];
+    a = a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f;
+    out[3] = std::uint8_t(std::floor(a * 255.0f + 0.5f));
+}
+
+float from_bits(std::uint32_t b) {
+    float f;
+    std::memcpy(&f, &b, sizeof f);
+    return f;
 }
 
 } // namespace
@@ -166,6 +188,77 @@ TEST_CASE("resolve_to_srgb8 equals the per-pixel reference") {
         CAPTURE(std::string(tonemap_name(tm)));
         CHECK(mismatches == 0);
     }
+}
+
+TEST_CASE("resolve_pixels_srgb8 (eight lanes) equals the reference on special values and every threshold") {
+    // Values: specials, both sides of every sRGB byte threshold (the floats
+    // where the reference's byte changes), and a wide random spread.
+    std::vector<float> values = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 1e-45f, -1e-45f, 1e-38f, 1e30f, -1e30f, 3.4e38f,
+                                 std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                                 std::numeric_limits<float>::quiet_NaN(), 0.76f, 0.04f, 0.08f, 2.0f, 65504.0f};
+    const Srgb8Encoder& enc = Srgb8Encoder::instance();
+    for (int b = 1; b < 256; ++b) {
+        const std::uint32_t t = enc.threshold_bits(b);
+        if (t == 0xFFFFFFFFu || t == 0) continue;
+        for (std::uint32_t d : {t - 2, t - 1, t, t + 1, t + 2}) values.push_back(from_bits(d));
+    }
+    std::uint32_t seed = 777u;
+    for (int i = 0; i < 4000; ++i) {
+        seed = seed * 1664525u + 1013904223u;
+        const float u = float(seed >> 8) * (1.0f / 16777216.0f);
+        values.push_back((seed & 1u ? 1.0f : -0.05f) * std::exp2(u * 24.0f - 16.0f));
+    }
+    // Pixels from consecutive values (so each channel and alpha meet them all);
+    // several counts, so the scalar tails run too.
+    std::vector<float> rgba;
+    for (std::size_t i = 0; i + 3 < values.size() * 4; ++i) rgba.push_back(values[(i * 7 + i / 5) % values.size()]);
+    const std::size_t pixels = rgba.size() / 4;
+    for (ToneMap tm : {ToneMap::None, ToneMap::Aces, ToneMap::Neutral})
+        for (float exposure : {1.0f, 0.7f, 3.3f}) {
+            CAPTURE(std::string(tonemap_name(tm)));
+            CAPTURE(exposure);
+            for (std::size_t count : {pixels, std::size_t(13), std::size_t(8), std::size_t(1)}) {
+                std::vector<std::uint8_t> got(count * 4), want(count * 4);
+                resolve_pixels_srgb8(rgba.data(), count, exposure, tm, got.data());
+                for (std::size_t p = 0; p < count; ++p) reference_pixel(&rgba[p * 4], exposure, tm, &want[p * 4]);
+                int mismatches = 0;
+                for (std::size_t i = 0; i < got.size(); ++i) mismatches += got[i] != want[i];
+                CHECK(mismatches == 0);
+            }
+        }
+}
+
+TEST_CASE("the tile-pass resolve of a frame equals the whole-image resolve byte for byte") {
+    DefaultScene d = make_default_scene();
+    const int W = 203, H = 117;
+    for (int samples : {1, 4})
+        for (int threads : {1, 3})
+            for (int tile : {16, 64}) {
+                for (DebugView view : {DebugView::None, DebugView::Normal, DebugView::Tiles}) {
+                    CAPTURE(samples);
+                    CAPTURE(threads);
+                    CAPTURE(tile);
+                    CAPTURE(int(view));
+                    Renderer r({threads, tile});
+                    SceneRenderer sr(d.scene, r);
+                    FrameSettings fs;
+                    fs.camera = d.camera;
+                    fs.lights = default_light_rig();
+                    fs.samples = samples;
+                    fs.view = view;
+                    Framebuffer fb(W, H);
+                    std::vector<std::uint8_t> tiles(std::size_t(W) * H * 4, 7), whole(tiles.size(), 9);
+                    ImageOutput out;
+                    out.rgba8 = tiles.data();
+                    out.exposure = 1.3f;
+                    out.tonemap = view == DebugView::Tiles ? ToneMap::Neutral : ToneMap::Aces;
+                    out.raw = view == DebugView::Normal;
+                    sr.render(fs, fb, &out);
+                    if (out.raw) resolve_raw8(fb.color.data(), W, H, whole.data());
+                    else resolve_to_srgb8(fb.color.data(), W, H, out.exposure, out.tonemap, whole.data());
+                    CHECK(tiles == whole);
+                }
+            }
 }
 
 } // TEST_SUITE

@@ -82,7 +82,7 @@ async function showPixel(x, y) {
     body.textContent = "";
     p.history.forEach((h, i) => {
       const tr = document.createElement("tr");
-      const cells = [String(i + 1), null, h.mesh, h.depth.toPrecision(7), h.result,
+      const cells = [String(i + 1), null, h.mesh, h.cover, h.pass, h.depth.toPrecision(7), h.result,
                      h.out ? "(" + h.out.map((v) => v.toPrecision(6)).join(", ") + ")" : ""];
       cells.forEach((c, k) => {
         const td = document.createElement("td");
@@ -91,10 +91,52 @@ async function showPixel(x, y) {
       });
       body.appendChild(tr);
     });
+    showSamples(p);
     $("pixel-text").textContent = p.text;
     status("");
   } catch (e) { status(e.message); }
   drawOverlay();
+}
+
+// The pixel's samples: where each lies in the pixel (the square), which
+// fragment of the history it ends the frame with, and its colour alone.
+function showSamples(p) {
+  const body = $("samples").querySelector("tbody");
+  body.textContent = "";
+  const c = $("sample-view"), g = c.getContext("2d"), n = c.width;
+  g.fillStyle = "#000";
+  g.fillRect(0, 0, n, n);
+  g.strokeStyle = "#555";
+  g.strokeRect(0.5, 0.5, n - 1, n - 1);
+  p.sample_list.forEach((s, k) => {
+    const rgb = "rgb(" + s.srgb8.join(",") + ")";
+    const holds = s.owner < 0 ? "cleared" : "#" + (s.owner + 1) + " (tri " + p.history[s.owner].tri + ")";
+    const tr = document.createElement("tr");
+    const offset = "(" + s.offset[0] + ", " + s.offset[1] + ")";
+    [String(k), offset, holds, s.depth.toPrecision(7)].forEach((t) => {
+      const td = document.createElement("td");
+      td.textContent = t;
+      tr.appendChild(td);
+    });
+    const td = document.createElement("td");
+    const sw = document.createElement("span");
+    sw.className = "swatch";
+    sw.style.background = rgb;
+    td.appendChild(sw);
+    td.appendChild(document.createTextNode("(" + s.color.map((v) => v.toPrecision(6)).join(", ") + ")"));
+    tr.appendChild(td);
+    body.appendChild(tr);
+    const x = (0.5 + s.offset[0]) * n, y = (0.5 + s.offset[1]) * n;
+    g.fillStyle = rgb;
+    g.strokeStyle = "#fff";
+    g.beginPath();
+    g.arc(x, y, n / 14, 0, 2 * Math.PI);
+    g.fill();
+    g.stroke();
+    g.fillStyle = "#fff";
+    g.font = "10px sans-serif";
+    g.fillText("s" + k, x + n / 12, y + 4);
+  });
 }
 
 async function showTile(tx, ty) {
@@ -130,8 +172,8 @@ async function start() {
     state.frame = await api("/api/frame");
     const stages = await api("/api/stages");
     const f = state.frame;
-    $("summary").textContent = f.width + "x" + f.height + ", " + f.triangles + " triangles, " + f.draws +
-      " draws, tiles of " + f.tile_size + ", recording " + (f.recording_bytes / 1048576).toFixed(1) + " MiB";
+    $("summary").textContent = f.width + "x" + f.height + ", " + f.samples + " sample" + (f.samples > 1 ? "s" : "") +
+      " per pixel, " + f.triangles + " triangles, " + f.draws + " draws, tiles of " + f.tile_size + ", recording " + (f.recording_bytes / 1048576).toFixed(1) + " MiB";
     $("frame-text").textContent = f.text;
     $("tri").max = f.triangles - 1;
     const sel = $("stage");

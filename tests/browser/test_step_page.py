@@ -65,6 +65,31 @@ def get(url):
         return e.code, json.loads(e.read().decode())
 
 
+def samples_in_text(text):
+    """{sample: what it holds} from the `samples after the frame` lines of a
+    pixel's text ("  s0 #2 (tri 43470) depth ..." -> {0: "#2 (tri 43470)"});
+    with one sample, from the "shading of #k (tri N)" line or the background."""
+    held = {}
+    for line in text.splitlines():
+        if line.startswith("  s") and " depth " in line and line[3].isdigit():
+            k = int(line[3:].split()[0])
+            held[k] = line.split(" ", 4)[3] if line.split()[1] == "cleared" else " ".join(line.split()[1:4])
+    if not held:
+        for line in text.splitlines():
+            if line.startswith("shading of #"):
+                held[0] = " ".join(line.split()[2:5]).rstrip(",")
+                break
+        else:
+            held[0] = "cleared"
+    return held
+
+
+def page_samples(p):
+    """The same from a pixel's JSON, as the page words it."""
+    return {k: "cleared" if s["owner"] < 0 else "#%d (tri %d)" % (s["owner"] + 1, p["history"][s["owner"]]["tri"])
+            for k, s in enumerate(p["sample_list"])}
+
+
 def start_server(step):
     server = subprocess.Popen([step] + FLAGS + ["--serve", "--port", "0"], stdout=subprocess.PIPE,
                               stderr=subprocess.PIPE, text=True)
@@ -76,11 +101,14 @@ def start_server(step):
 
 
 def stop_server(server):
+    """Stops the server; fails on anything a sanitizer build reported."""
     server.terminate()
     try:
-        server.wait(timeout=10)
+        _, err = server.communicate(timeout=30)
     except subprocess.TimeoutExpired:
         server.kill()
+        _, err = server.communicate()
+    assert "runtime error" not in err and "Sanitizer" not in err, err
 
 
 def api_checks(step):
@@ -94,6 +122,7 @@ def api_checks(step):
             code, p = get(base + "/api/pixel?x=%d&y=%d" % (x, y))
             assert code == 200 and p["text"] == step_text(step, "pixel %d %d\n" % (x, y)), (x, y)
             assert p["text"].count("\nsrgb8 ") == 1
+            assert len(p["sample_list"]) == frame["samples"] and page_samples(p) == samples_in_text(p["text"]), p
         code, t = get(base + "/api/tri?n=98372")
         assert code == 200 and t["text"] == step_text(step, "tri 98372\n")
         code, t = get(base + "/api/tile?x=2&y=1")
@@ -182,8 +211,19 @@ def main():
         assert "srgb8 " in shown and "shading of #" in shown
         rows = driver.find_elements(By.CSS_SELECTOR, "#history tbody tr")
         assert len(rows) >= 1
-        print("pixel %d %d: the page shows step's breakdown exactly (%d lines, %d history rows)"
-              % (x, y, shown.count("\n"), len(rows)))
+        # The samples table: one row per sample, holding what the text says.
+        frame = get(url.rstrip("/") + "/api/frame")[1]
+        sample_rows = driver.find_elements(By.CSS_SELECTOR, "#samples tbody tr")
+        assert len(sample_rows) == frame["samples"], len(sample_rows)
+        shown_held = {k: r.find_elements(By.TAG_NAME, "td")[2].text for k, r in enumerate(sample_rows)}
+        assert shown_held == samples_in_text(expected), (shown_held, samples_in_text(expected))
+        # The history's sample columns: those of the text's "covers samples" lines.
+        if frame["samples"] > 1:
+            covers = [l.split("covers samples ")[1].split(" of")[0] for l in expected.splitlines()
+                      if l.startswith("     covers samples ")]
+            assert [r.find_elements(By.TAG_NAME, "td")[3].text for r in rows] == covers
+        print("pixel %d %d: the page shows step's breakdown exactly (%d lines, %d history rows, %d samples)"
+              % (x, y, shown.count("\n"), len(rows), len(sample_rows)))
 
         # The triangle of the first fragment: its setup as `tri N` prints it.
         link = driver.find_element(By.CSS_SELECTOR, "#history a.tri")

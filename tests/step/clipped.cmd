@@ -2,5 +2,7 @@
 frame
 tri 98368
 tri 98369
+# piece 0 and piece 1 of tri 98369
+pixel 120 570
+pixel 200 556
 pixel 640 700
-pixel 100 715

@@ -1,0 +1,524 @@
+// llvmpipe-render: the same frame as `render`, drawn by Mesa's llvmpipe through
+// OSMesa and OpenGL 3.3 core, for side-by-side speed comparisons
+// (`bench --side-by-side build/llvmpipe-render build/render`). It takes
+// render's command line (apps/render_options.h), loads the scene with prast's
+// own loaders and image decoders, frames and lights it as render does, and
+// shades with a GLSL port of the conventions' Cook-Torrance (shading/brdf.h,
+// surface.h): metal-roughness maps, tangent-space normal maps, occlusion,
+// emissive, suns and point lights, the flat ambient term, exposure, the ACES /
+// neutral / clamp tone maps and the sRGB encoding. Textures are uploaded in
+// their 8-bit form (sRGB formats for colour maps) and glGenerateMipmap builds
+// their chains; sampling is trilinear, as render's.
+//
+// Not ported (the bench workloads do not use them): measured conductors (Pc),
+// alpha MASK, debug views, image-based lighting, shadows, blending.
+//
+// Timing: `--repeat N` prints `frame_ms min=.. median=.. max=..` like render,
+// where a frame is the clear, every draw, the tone map and a glFinish (the
+// tone map runs in the fragment shader at 1 sample; with --msaa N > 1 the
+// linear radiance is resolved by a blit and tone mapped in a second pass, as
+// render averages linear radiance before its tone map). --threads N sets
+// LP_NUM_THREADS. Built only with -DPRAST_LLVMPIPE=ON (libosmesa6-dev).
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/osmesa.h>
+#include <GL/glcorearb.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "apps/render_options.h"
+#include "scene/camera.h"
+#include "scene/default_scene.h"
+#include "scene/image.h"
+#include "scene/load_scene.h"
+#include "scene/write_image.h"
+#include "shading/scene_renderer.h"
+
+using namespace prast;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+const char* kVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+layout(location = 3) in vec4 a_tangent;
+uniform mat4 u_view_proj;
+out vec3 v_position; out vec3 v_normal; out vec2 v_uv; out vec4 v_tangent;
+void main() {
+    v_position = a_position; v_normal = a_normal; v_uv = a_uv; v_tangent = a_tangent;
+    gl_Position = u_view_proj * vec4(a_position, 1.0);
+}
+)";
+
+// The conventions' Cook-Torrance, line for line with shading/brdf.h and
+// shading/surface.h (default BRDF).
+const char* kFragmentShader = R"(#version 330 core
+in vec3 v_position; in vec3 v_normal; in vec2 v_uv; in vec4 v_tangent;
+out vec4 o_color;
+uniform vec4 u_base_color_factor;
+uniform float u_metallic_factor, u_roughness_factor, u_normal_scale, u_occlusion_strength, u_ior;
+uniform vec3 u_emissive_factor;
+uniform int u_maps;  // bits: 1 base, 2 metal-rough, 4 rough, 8 metal, 16 normal, 32 occlusion, 64 emissive
+uniform sampler2D t_base, t_mr, t_rough, t_metal, t_normal, t_occlusion, t_emissive;
+uniform vec3 u_eye;
+uniform int u_light_count;
+uniform vec4 u_light[8];        // xyz: direction towards the light (w = 0) or position (w = 1)
+uniform vec3 u_light_radiance[8];
+uniform vec3 u_ambient;
+uniform int u_linear_out;       // 1: write linear radiance (MSAA resolve pass follows)
+uniform float u_exposure;
+uniform int u_tonemap;          // 0 none, 1 aces, 2 neutral
+const float PI = 3.14159265358979;
+
+vec3 safe_normalize(vec3 v, vec3 fallback) {
+    float len2 = dot(v, v);
+    return len2 > 1e-20 ? v / sqrt(len2) : fallback;
+}
+float aces(float x) {
+    return clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+}
+vec3 neutral(vec3 c) {
+    c = max(c, vec3(0.0));
+    float x = min(c.r, min(c.g, c.b));
+    float offset = x < 0.08 ? x - 6.25 * x * x : 0.04;
+    c -= offset;
+    float peak = max(c.r, max(c.g, c.b));
+    if (peak < 0.76) return c;
+    float d = 0.24;
+    float new_peak = 1.0 - d * d / (peak + d - 0.76);
+    c *= new_peak / peak;
+    float g = 1.0 - 1.0 / (0.15 * (peak - new_peak) + 1.0);
+    return mix(c, vec3(new_peak), g);
+}
+float srgb_encode(float c) {
+    return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+}
+vec3 display(vec3 c) {
+    c *= u_exposure;
+    if (u_tonemap == 1) c = vec3(aces(c.r), aces(c.g), aces(c.b));
+    else if (u_tonemap == 2) c = clamp(neutral(c), 0.0, 1.0);
+    else c = clamp(c, 0.0, 1.0);
+    return vec3(srgb_encode(c.r), srgb_encode(c.g), srgb_encode(c.b));
+}
+
+void main() {
+    vec4 base = u_base_color_factor;
+    if ((u_maps & 1) != 0) base *= texture(t_base, v_uv);
+    float metallic = u_metallic_factor, roughness = u_roughness_factor;
+    if ((u_maps & 2) != 0) { vec4 mr = texture(t_mr, v_uv); roughness *= mr.g; metallic *= mr.b; }
+    if ((u_maps & 4) != 0) roughness *= texture(t_rough, v_uv).r;
+    if ((u_maps & 8) != 0) metallic *= texture(t_metal, v_uv).r;
+    metallic = clamp(metallic, 0.0, 1.0);
+    roughness = clamp(roughness, 0.0, 1.0);
+    float occlusion = 1.0;
+    if ((u_maps & 32) != 0) occlusion = 1.0 + u_occlusion_strength * (texture(t_occlusion, v_uv).r - 1.0);
+    vec3 emissive = u_emissive_factor;
+    if ((u_maps & 64) != 0) emissive *= texture(t_emissive, v_uv).rgb;
+
+    vec3 N = safe_normalize(v_normal, vec3(0.0, 0.0, 1.0));
+    float flip = gl_FrontFacing ? 1.0 : -1.0;
+    vec3 n = N * flip;
+    if ((u_maps & 16) != 0) {
+        vec3 T = safe_normalize(v_tangent.xyz - N * dot(N, v_tangent.xyz), vec3(0.0));
+        if (dot(T, T) > 0.0) {
+            float w = v_tangent.w < 0.0 ? -1.0 : 1.0;
+            vec3 B = cross(N, T) * w;
+            vec3 nt = texture(t_normal, v_uv).rgb * 2.0 - 1.0;
+            nt.xy *= u_normal_scale;
+            nt = safe_normalize(nt, vec3(0.0, 0.0, 1.0));
+            n = safe_normalize(T * nt.x + B * nt.y + N * nt.z, N) * flip;
+        }
+    }
+    vec3 v = safe_normalize(u_eye - v_position, n);
+    float r = clamp(roughness, 0.045, 1.0);
+    float alpha = r * r, a2 = alpha * alpha;
+    float f0d = (1.0 - u_ior) / (1.0 + u_ior);
+    vec3 F0 = mix(vec3(f0d * f0d), base.rgb, metallic);
+    float k = (r + 1.0) * (r + 1.0) / 8.0;
+    float NoV = clamp(dot(n, v), 0.0, 1.0);
+    vec3 Lo = emissive;
+    for (int i = 0; i < u_light_count; ++i) {
+        vec3 l, radiance;
+        if (u_light[i].w == 0.0) { l = u_light[i].xyz; radiance = u_light_radiance[i]; }
+        else {
+            vec3 d = u_light[i].xyz - v_position;
+            float d2 = dot(d, d);
+            if (!(d2 > 1e-12)) continue;
+            l = d / sqrt(d2);
+            radiance = u_light_radiance[i] / d2;
+        }
+        vec3 sum = l + v;
+        float len2 = dot(sum, sum);
+        vec3 h = len2 > 0.0 ? sum / sqrt(len2) : n;
+        float NoL = clamp(dot(n, l), 0.0, 1.0);
+        float NoH = clamp(dot(n, h), 0.0, 1.0);
+        float VoH = clamp(dot(v, h), 0.0, 1.0);
+        vec3 F = F0 + (1.0 - F0) * pow(1.0 - VoH, 5.0);
+        float dd = NoH * NoH * (a2 - 1.0) + 1.0;
+        float D = a2 / (PI * dd * dd);
+        float G = (NoV / (NoV * (1.0 - k) + k)) * (NoL / (NoL * (1.0 - k) + k));
+        vec3 specular = D * G * F / (4.0 * max(NoV, 1e-4) * max(NoL, 1e-4));
+        vec3 kd = (1.0 - F) * (1.0 - metallic);
+        Lo += (kd * base.rgb / PI + specular) * radiance * NoL;
+    }
+    Lo += u_ambient * base.rgb * occlusion;
+    o_color = u_linear_out != 0 ? vec4(Lo, 1.0) : vec4(display(Lo), 1.0);
+}
+)";
+
+// The second pass with --msaa: the resolved linear image, tone mapped.
+const char* kQuadVertexShader = R"(#version 330 core
+void main() {
+    vec2 p = vec2((gl_VertexID & 1) * 4 - 1, (gl_VertexID >> 1) * 4 - 1);
+    gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+const char* kToneMapShader = R"(#version 330 core
+uniform sampler2D t_linear;
+uniform float u_exposure;
+uniform int u_tonemap;
+out vec4 o_color;
+float aces(float x) { return clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0); }
+float srgb_encode(float c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055; }
+void main() {
+    vec3 c = texelFetch(t_linear, ivec2(gl_FragCoord.xy), 0).rgb * u_exposure;
+    c = u_tonemap == 1 ? vec3(aces(c.r), aces(c.g), aces(c.b)) : clamp(c, 0.0, 1.0);
+    o_color = vec4(srgb_encode(c.r), srgb_encode(c.g), srgb_encode(c.b), 1.0);
+}
+)";
+
+[[noreturn]] void die(const std::string& message, int code = 1) {
+    std::fprintf(stderr, "llvmpipe-render: %s\n", message.c_str());
+    std::exit(code);
+}
+
+GLuint compile(GLenum type, const char* source) {
+    GLuint s = glCreateShader(type);
+    glShaderSource(s, 1, &source, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[4096];
+        glGetShaderInfoLog(s, sizeof log, nullptr, log);
+        die(std::string("shader compile error: ") + log);
+    }
+    return s;
+}
+
+GLuint link_program(const char* vs, const char* fs) {
+    GLuint p = glCreateProgram();
+    glAttachShader(p, compile(GL_VERTEX_SHADER, vs));
+    glAttachShader(p, compile(GL_FRAGMENT_SHADER, fs));
+    glLinkProgram(p);
+    GLint ok = 0;
+    glGetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) die("shader link error");
+    return p;
+}
+
+GLint wrap_gl(Wrap w) {
+    return w == Wrap::ClampToEdge ? GL_CLAMP_TO_EDGE : w == Wrap::MirroredRepeat ? GL_MIRRORED_REPEAT : GL_REPEAT;
+}
+
+// One decoded image as a GL texture with a generated mip chain.
+GLuint upload(const Image& img, const TextureRef& ref) {
+    GLuint tex = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    if (!img.is_8bit()) {
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, img.width, img.height, 0, GL_RGBA, GL_FLOAT, img.rgba.data());
+    } else {
+        // sRGB formats exist for RGB(A) only: grey sRGB maps go up as RGB.
+        std::vector<std::uint8_t> expanded;
+        const std::uint8_t* px = img.pixels.data();
+        int channels = img.channels;
+        if (img.srgb && channels <= 2) {
+            expanded.resize(img.texel_count() * std::size_t(channels + 2));
+            for (std::size_t i = 0; i < img.texel_count(); ++i) {
+                std::uint8_t g = px[i * channels];
+                std::uint8_t* o = &expanded[i * std::size_t(channels + 2)];
+                o[0] = o[1] = o[2] = g;
+                if (channels == 2) o[3] = px[i * 2 + 1];
+            }
+            px = expanded.data();
+            channels += 2;
+        }
+        static const GLenum kFormat[5] = {0, GL_RED, GL_RG, GL_RGB, GL_RGBA};
+        static const GLint kLinear[5] = {0, GL_R8, GL_RG8, GL_RGB8, GL_RGBA8};
+        static const GLint kSrgb[5] = {0, 0, 0, GL_SRGB8, GL_SRGB8_ALPHA8};
+        glTexImage2D(GL_TEXTURE_2D, 0, img.srgb ? kSrgb[channels] : kLinear[channels], img.width, img.height, 0,
+                     kFormat[channels], GL_UNSIGNED_BYTE, px);
+        if (img.channels <= 2 && !img.srgb) {
+            // Grey reads as (g, g, g) like prast's samplers; grey+alpha keeps alpha.
+            GLint swizzle[4] = {GL_RED, GL_RED, GL_RED, img.channels == 2 ? GL_GREEN : GL_ONE};
+            glTexParameteriv(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_RGBA, swizzle);
+        }
+    }
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap_gl(ref.wrap_s));
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap_gl(ref.wrap_t));
+    return tex;
+}
+
+struct GpuMesh {
+    GLuint vao = 0;
+    GLsizei count = 0;
+    int material = 0;
+};
+
+GpuMesh upload(const Mesh& m) {
+    GpuMesh g;
+    g.material = m.material;
+    g.count = GLsizei(m.indices.size());
+    glGenVertexArrays(1, &g.vao);
+    glBindVertexArray(g.vao);
+    // Interleaved: position 3, normal 3, uv 2, tangent 4.
+    std::vector<float> v(m.positions.size() * 12, 0.0f);
+    for (std::size_t i = 0; i < m.positions.size(); ++i) {
+        float* o = &v[i * 12];
+        o[0] = m.positions[i].x; o[1] = m.positions[i].y; o[2] = m.positions[i].z;
+        glm::vec3 n = i < m.normals.size() ? m.normals[i] : glm::vec3(0, 0, 1);
+        o[3] = n.x; o[4] = n.y; o[5] = n.z;
+        glm::vec2 uv = i < m.uvs.size() ? m.uvs[i] : glm::vec2(0.0f);
+        o[6] = uv.x; o[7] = uv.y;
+        glm::vec4 t = i < m.tangents.size() ? m.tangents[i] : glm::vec4(1, 0, 0, 1);
+        o[8] = t.x; o[9] = t.y; o[10] = t.z; o[11] = t.w;
+    }
+    GLuint buffers[2];
+    glGenBuffers(2, buffers);
+    glBindBuffer(GL_ARRAY_BUFFER, buffers[0]);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(v.size() * sizeof(float)), v.data(), GL_STATIC_DRAW);
+    const int sizes[4] = {3, 3, 2, 4}, offsets[4] = {0, 3, 6, 8};
+    for (int a = 0; a < 4; ++a) {
+        glEnableVertexAttribArray(GLuint(a));
+        glVertexAttribPointer(GLuint(a), sizes[a], GL_FLOAT, GL_FALSE, 12 * sizeof(float),
+                              reinterpret_cast<const void*>(std::size_t(offsets[a]) * sizeof(float)));
+    }
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffers[1]);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * sizeof(std::uint32_t)), m.indices.data(),
+                 GL_STATIC_DRAW);
+    return g;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    RenderOptions opt;
+    const std::string err = parse_render_args(argc, argv, opt);
+    if (!err.empty()) die(err, 2);
+    if (opt.help) {
+        std::printf("llvmpipe-render: render's command line, drawn by Mesa's llvmpipe (see apps/llvmpipe_render.cpp)\n");
+        return 0;
+    }
+    if (opt.hdr_output()) die("only PNG output", 2);
+    // llvmpipe reads its thread count once, when the context is made.
+    if (opt.threads > 0) setenv("LP_NUM_THREADS", std::to_string(opt.threads).c_str(), 1);
+
+    // Scene, camera and lights exactly as render sets them up (frame 0).
+    Scene scene;
+    Camera camera;
+    if (opt.scene.empty()) {
+        DefaultScene d = make_default_scene();
+        scene = std::move(d.scene);
+        camera = d.camera;
+    } else {
+        try {
+            scene = load_scene(opt.scene);
+        } catch (const std::exception& e) {
+            die(e.what());
+        }
+    }
+    const Bounds bounds = scene.bounds();
+    const float aspect = float(opt.width) / float(opt.height);
+    if (!opt.scene.empty()) camera = frame_bounds(bounds, opt.fov_deg, aspect);
+    camera.fov_y_deg = opt.fov_deg;
+    if (opt.eye) camera.eye = *opt.eye;
+    if (opt.target) camera.target = *opt.target;
+    if (opt.up) camera.up = glm::normalize(*opt.up);
+    fit_clip_planes(camera, bounds);
+    if (opt.near_plane) camera.near_plane = *opt.near_plane;
+    if (opt.far_plane) camera.far_plane = *opt.far_plane;
+    std::vector<ShadingLight> lights = shading_lights(scene);
+    lights.insert(lights.end(), opt.lights.begin(), opt.lights.end());
+    if (lights.empty() && !opt.no_default_lights) lights = default_light_rig();
+    if (lights.size() > 8) die("more than 8 lights");
+
+    // A GL 3.3 core context rendering into client memory.
+    const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
+                           OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+    OSMesaContext ctx = OSMesaCreateContextAttribs(attribs, nullptr);
+    if (!ctx) die("cannot create an OSMesa GL 3.3 core context");
+    std::vector<std::uint8_t> window(std::size_t(opt.width) * opt.height * 4);
+    if (!OSMesaMakeCurrent(ctx, window.data(), GL_UNSIGNED_BYTE, opt.width, opt.height))
+        die("OSMesaMakeCurrent failed");
+
+    // Textures: decode as render does (prast's decoders), upload, mip.
+    std::vector<GLuint> textures(scene.images.size() * 2, 0);
+    auto texture = [&](const TextureRef& r, bool srgb) -> GLuint {
+        if (!r.valid() || std::size_t(r.image) >= scene.images.size()) return 0;
+        GLuint& t = textures[std::size_t(r.image) * 2 + srgb];
+        if (!t) {
+            const ImageSource& src = scene.images[std::size_t(r.image)];
+            try {
+                t = upload(src.decoded ? *src.decoded : decode_image(src, srgb), r);
+            } catch (const std::exception& e) {
+                std::fprintf(stderr, "llvmpipe-render: warning: %s (texture ignored)\n", e.what());
+            }
+        }
+        return t;
+    };
+    struct GpuMaterial {
+        const Material* m;
+        GLuint tex[7];
+        int maps = 0;
+    };
+    std::vector<GpuMaterial> materials;
+    for (const Material& m : scene.materials) {
+        GpuMaterial g{&m, {texture(m.base_color, true), texture(m.metallic_roughness, false),
+                          texture(m.roughness, false), texture(m.metallic, false), texture(m.normal, false),
+                          texture(m.occlusion, false), texture(m.emissive, true)}};
+        for (int i = 0; i < 7; ++i) g.maps |= g.tex[i] ? 1 << i : 0;
+        materials.push_back(g);
+    }
+    std::vector<GpuMesh> meshes;
+    for (const Mesh& m : scene.meshes) meshes.push_back(upload(m));
+
+    const GLuint program = link_program(kVertexShader, kFragmentShader);
+    glUseProgram(program);
+    auto loc = [&](GLuint p, const char* name) { return glGetUniformLocation(p, name); };
+    const char* samplers[7] = {"t_base", "t_mr", "t_rough", "t_metal", "t_normal", "t_occlusion", "t_emissive"};
+    for (int i = 0; i < 7; ++i) glUniform1i(loc(program, samplers[i]), i);
+    const glm::mat4 vp = camera.view_projection(aspect);
+    glUniformMatrix4fv(loc(program, "u_view_proj"), 1, GL_FALSE, &vp[0][0]);
+    glUniform3f(loc(program, "u_eye"), camera.eye.x, camera.eye.y, camera.eye.z);
+    glUniform1i(loc(program, "u_light_count"), GLint(lights.size()));
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        const ShadingLight& L = lights[i];
+        const glm::vec3 p = L.point ? L.position : L.direction;
+        glUniform4f(loc(program, ("u_light[" + std::to_string(i) + "]").c_str()), p.x, p.y, p.z, L.point ? 1.0f : 0.0f);
+        glUniform3f(loc(program, ("u_light_radiance[" + std::to_string(i) + "]").c_str()), L.radiance.x,
+                    L.radiance.y, L.radiance.z);
+    }
+    glUniform3f(loc(program, "u_ambient"), opt.ambient.x, opt.ambient.y, opt.ambient.z);
+    const int tonemap = opt.effective_tonemap() == ToneMap::Aces ? 1 : opt.effective_tonemap() == ToneMap::Neutral ? 2 : 0;
+    glUniform1f(loc(program, "u_exposure"), opt.exposure);
+    glUniform1i(loc(program, "u_tonemap"), tonemap);
+    const bool msaa = opt.msaa > 1;
+    glUniform1i(loc(program, "u_linear_out"), msaa ? 1 : 0);
+
+    // With MSAA: a multisampled linear float target, resolved by a blit, then
+    // tone mapped into the window by a full-screen pass.
+    GLuint ms_fbo = 0, resolve_fbo = 0, resolved = 0, tonemap_program = 0;
+    if (msaa) {
+        GLuint rb[2];
+        glGenFramebuffers(1, &ms_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+        glGenRenderbuffers(2, rb);
+        glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, opt.msaa, GL_RGBA16F, opt.width, opt.height);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
+        glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, opt.msaa, GL_DEPTH_COMPONENT24, opt.width, opt.height);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) die("multisampled target incomplete");
+        glGenTextures(1, &resolved);
+        glBindTexture(GL_TEXTURE_2D, resolved);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, opt.width, opt.height, 0, GL_RGBA, GL_FLOAT, nullptr);
+        glGenFramebuffers(1, &resolve_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, resolved, 0);
+        tonemap_program = link_program(kQuadVertexShader, kToneMapShader);
+        glUseProgram(tonemap_program);
+        glUniform1i(loc(tonemap_program, "t_linear"), 0);
+        glUniform1f(loc(tonemap_program, "u_exposure"), opt.exposure);
+        glUniform1i(loc(tonemap_program, "u_tonemap"), tonemap);
+    }
+    GLuint empty_vao = 0;
+    glGenVertexArrays(1, &empty_vao);
+
+    auto frame = [&]() {
+        glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+        glViewport(0, 0, opt.width, opt.height);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glClearColor(0, 0, 0, 1);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        glUseProgram(program);
+        glFrontFace(GL_CCW);
+        for (const GpuMesh& g : meshes) {
+            const GpuMaterial& gm = materials[std::size_t(g.material)];
+            const Material& m = *gm.m;
+            if (m.double_sided) glDisable(GL_CULL_FACE);
+            else { glEnable(GL_CULL_FACE); glCullFace(GL_BACK); }
+            glUniform4fv(loc(program, "u_base_color_factor"), 1, &m.base_color_factor[0]);
+            glUniform1f(loc(program, "u_metallic_factor"), m.metallic_factor);
+            glUniform1f(loc(program, "u_roughness_factor"), m.roughness_factor);
+            glUniform1f(loc(program, "u_normal_scale"), m.normal_scale);
+            glUniform1f(loc(program, "u_occlusion_strength"), m.occlusion_strength);
+            glUniform1f(loc(program, "u_ior"), m.ior);
+            glUniform3fv(loc(program, "u_emissive_factor"), 1, &m.emissive_factor[0]);
+            glUniform1i(loc(program, "u_maps"), gm.maps);
+            for (int i = 0; i < 7; ++i) {
+                glActiveTexture(GLenum(GL_TEXTURE0 + i));
+                glBindTexture(GL_TEXTURE_2D, gm.tex[i]);
+            }
+            glBindVertexArray(g.vao);
+            glDrawElements(GL_TRIANGLES, g.count, GL_UNSIGNED_INT, nullptr);
+        }
+        if (msaa) {
+            glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_fbo);
+            glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
+            glBlitFramebuffer(0, 0, opt.width, opt.height, 0, 0, opt.width, opt.height, GL_COLOR_BUFFER_BIT,
+                              GL_NEAREST);
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            glDisable(GL_DEPTH_TEST);
+            glDisable(GL_CULL_FACE);
+            glUseProgram(tonemap_program);
+            glActiveTexture(GL_TEXTURE0);
+            glBindTexture(GL_TEXTURE_2D, resolved);
+            glBindVertexArray(empty_vao);
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+        }
+        glFinish();
+    };
+
+    std::vector<double> times;
+    for (int r = 0; r < opt.repeat; ++r) {
+        const auto t0 = Clock::now();
+        frame();
+        times.push_back(ms_since(t0));
+    }
+    if (glGetError() != GL_NO_ERROR) die("OpenGL reported an error");
+    if (opt.repeat_given) {
+        std::sort(times.begin(), times.end());
+        const std::size_t n = times.size();
+        const double median = n % 2 ? times[n / 2] : 0.5 * (times[n / 2 - 1] + times[n / 2]);
+        std::printf("frame_ms min=%.3f median=%.3f max=%.3f\n", times.front(), median, times.back());
+    }
+    // The window's row 0 is the bottom row: flip to the image's top-down rows.
+    std::vector<std::uint8_t> rgba8(window.size());
+    const std::size_t row = std::size_t(opt.width) * 4;
+    for (int y = 0; y < opt.height; ++y)
+        std::copy_n(&window[std::size_t(opt.height - 1 - y) * row], row, &rgba8[std::size_t(y) * row]);
+    try {
+        write_png_atomic(opt.output, opt.width, opt.height, rgba8.data());
+    } catch (const std::exception& e) {
+        die(e.what());
+    }
+    OSMesaDestroyContext(ctx);
+    return 0;
+}

@@ -1,0 +1,84 @@
+// Tile storage at the start and the end of a tile pass; see resolve.h.
+#include "raster/resolve.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace prast {
+
+void clear_tile(Framebuffer& fb, const TileRect& r, const float rgba[4], float depth) {
+    const std::size_t w = std::size_t(r.width());
+    for (int y = r.y0; y <= r.y1; ++y) {
+        const std::size_t row = std::size_t(y) * std::size_t(fb.width) + std::size_t(r.x0);
+        std::fill(fb.depth.begin() + std::ptrdiff_t(row), fb.depth.begin() + std::ptrdiff_t(row + w), depth);
+        if (!fb.has_color()) continue;
+        float* c = &fb.color[row * 4];
+        for (std::size_t i = 0; i < w; ++i, c += 4) std::memcpy(c, rgba, 4 * sizeof(float));
+    }
+}
+
+void clear_samples(float* color, float* depth, int size, int samples, const float rgba[4], float z) {
+    const std::size_t n = std::size_t(size) * std::size_t(size) * std::size_t(samples);
+    std::fill(depth, depth + n, z);
+    if (!color) return;
+    for (std::size_t i = 0; i < n; ++i) std::memcpy(color + 4 * i, rgba, 4 * sizeof(float));
+}
+
+void load_samples(const Framebuffer& fb, const TileRect& r, float* color, float* depth, int size, int samples) {
+    const std::size_t plane = std::size_t(size) * std::size_t(size);
+    for (int y = r.y0; y <= r.y1; ++y)
+        for (int x = r.x0; x <= r.x1; ++x) {
+            const std::size_t src = std::size_t(y) * std::size_t(fb.width) + std::size_t(x);
+            const std::size_t dst = std::size_t(y - r.y0) * std::size_t(size) + std::size_t(x - r.x0);
+            for (int s = 0; s < samples; ++s) {
+                depth[dst + s * plane] = fb.depth[src];
+                if (color) std::memcpy(color + (dst + s * plane) * 4, &fb.color[src * 4], 4 * sizeof(float));
+            }
+        }
+}
+
+namespace {
+
+// Pairwise sums: ((s0 + s1) + (s2 + s3)) + ... so that n equal values sum to
+// exactly n times the value (n a power of two), and their mean is the value.
+template <int S>
+inline void resolve_row(const float* color, const float* depth, std::size_t plane, int width, float* out_color,
+                        float* out_depth) {
+    constexpr float kInv = 1.0f / float(S);
+    for (int x = 0; x < width; ++x) {
+        float z = depth[x];
+        for (int s = 1; s < S; ++s) z = std::min(z, depth[x + s * plane]);
+        out_depth[x] = z;
+        if (!color) continue;
+        for (int ch = 0; ch < 4; ++ch) {
+            float v[S];
+            for (int s = 0; s < S; ++s) v[s] = color[(x + s * plane) * 4 + ch];
+            for (int n = S; n > 1; n /= 2)
+                for (int i = 0; i < n / 2; ++i) v[i] = v[2 * i] + v[2 * i + 1];
+            out_color[x * 4 + ch] = v[0] * kInv;
+        }
+    }
+}
+
+} // namespace
+
+void resolve_samples(const float* color, const float* depth, int size, int samples, const TileRect& r,
+                     Framebuffer& fb) {
+    const std::size_t plane = std::size_t(size) * std::size_t(size);
+    for (int y = r.y0; y <= r.y1; ++y) {
+        const std::size_t src = std::size_t(y - r.y0) * std::size_t(size);
+        const std::size_t dst = std::size_t(y) * std::size_t(fb.width) + std::size_t(r.x0);
+        const float* c = color ? color + src * 4 : nullptr;
+        float* oc = fb.has_color() ? &fb.color[dst * 4] : nullptr;
+        if (!oc) c = nullptr;
+        float* od = &fb.depth[dst];
+        switch (samples) {
+        case 2: resolve_row<2>(c, depth + src, plane, r.width(), oc, od); break;
+        case 4: resolve_row<4>(c, depth + src, plane, r.width(), oc, od); break;
+        case 8: resolve_row<8>(c, depth + src, plane, r.width(), oc, od); break;
+        default: resolve_row<1>(c, depth + src, plane, r.width(), oc, od); break;
+        }
+    }
+}
+
+} // namespace prast

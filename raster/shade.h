@@ -1,0 +1,278 @@
+// Shading a 4x4 block: interpolate a triangle's varyings perspective-correctly
+// for the block's lanes, call the fragment program once for the block (once
+// per pixel per triangle whatever the sample count), and write its output to
+// the samples it owns, replacing or blending. Two callers:
+//  - shade_in_order(): draws shaded in submission order (blending, alpha
+//    MASK, depth test or write off): depth test, shade, write, as a draw
+//    call always did;
+//  - shade_winner(): the visibility pass already wrote depth and chose each
+//    sample's winner; this shades a winning triangle for the pixels it won
+//    (with the whole block's helper lanes, so derivatives are unchanged).
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include "raster/bin.h"
+#include "raster/draw_state.h"
+#include "raster/fragment.h"
+#include "raster/rasterize.h"
+
+namespace prast {
+namespace detail {
+
+// A triangle's varyings as (v0, v1 - v0, v2 - v0), from the draw's vertices or
+// the clip pool of the job that made them.
+template <int NV>
+struct TriangleVaryings {
+    float v0[NV > 0 ? NV : 1], d1[NV > 0 ? NV : 1], d2[NV > 0 ? NV : 1];
+};
+
+template <int NV>
+inline void prepare_varyings(const TriangleSetup& t, const float* vertices, const BinJob& job,
+                             TriangleVaryings<NV>& p) {
+    constexpr int stride = 4 + NV;
+    const float* v[3];
+    for (int i = 0; i < 3; ++i) {
+        std::uint32_t r = t.vtx[i];
+        v[i] = (r & kClippedVertexBit) ? &job.clip_pool[std::size_t(r & ~kClippedVertexBit) * stride]
+                                       : &vertices[std::size_t(r) * stride];
+    }
+    for (int k = 0; k < NV; ++k) {
+        p.v0[k] = v[0][4 + k];
+        p.d1[k] = v[1][4 + k] - v[0][4 + k];
+        p.d2[k] = v[2][4 + k] - v[0][4 + k];
+    }
+}
+
+// Eight floats with lane-wise IEEE arithmetic (the GCC/Clang vector
+// extension), for the block loops that the auto-vectoriser gets wrong: given
+// the interpolation loop, it vectorises across varyings and transposes. Only
+// ever a local variable: as a parameter or return value by value its ABI would
+// depend on AVX (-Wpsabi).
+typedef float Lanes8 __attribute__((vector_size(32)));
+inline void load_lanes(Lanes8& v, const float* p) { std::memcpy(&v, p, sizeof v); }
+inline void store_lanes(float* p, const Lanes8& v) { std::memcpy(p, &v, sizeof v); }
+
+// One lane's varyings and depth at screen barycentrics (b0, b1, b2): the
+// float operations of the block loop below, for one lane.
+template <int NV>
+inline void interpolate_lane(const TriangleSetup& t, const TriangleVaryings<NV>& p, float b0, float b1, float b2,
+                             int l, FragmentBlock<NV>& in) {
+    in.z[l] = depth_from_barycentrics(t, b0, b1, b2);
+    const float q0 = b0 * t.inv_w[0], q1 = b1 * t.inv_w[1], q2 = b2 * t.inv_w[2];
+    const float s = 1.0f / (q0 + q1 + q2);
+    const float w1 = q1 * s, w2 = q2 * s;
+    for (int k = 0; k < NV; ++k) in.var[k][l] = p.v0[k] + w1 * p.d1[k] + w2 * p.d2[k];
+}
+
+// Depth and varyings of the block's lanes at their pixel centres; with
+// several samples, the live lanes (`lanes`) whose centre is outside the
+// triangle move to the centroid of their covered samples.
+// `centre`: the lanes' centre barycentrics and depths when the caller has
+// them (one sample: test_depth's), else null.
+template <bool MS, int NV>
+void interpolate_block(const TriangleSetup& t, const TriangleVaryings<NV>& p, const SamplePattern& sp, int bx,
+                       int by, std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in) {
+    alignas(64) float cb0[kBlockLanes], cb1[kBlockLanes], cb2[kBlockLanes];
+    const float *b0 = cb0, *b1 = cb1, *b2 = cb2;
+    if (centre) {
+        b0 = centre->b0;
+        b1 = centre->b1;
+        b2 = centre->b2;
+        std::memcpy(in.z, centre->z[0], sizeof in.z);
+    } else {
+        block_barycentrics<false>(t, bx, by, 0.0f, 0.0f, cb0, cb1, cb2);
+        for (int l = 0; l < kBlockLanes; ++l) in.z[l] = depth_from_barycentrics(t, b0[l], b1[l], b2[l]);
+    }
+
+    // Perspective-correct weights: screen barycentrics over w, renormalised;
+    // then every varying, eight lanes at a time.
+    for (int h = 0; h < kBlockLanes; h += 8) {
+        Lanes8 q0, q1, q2;
+        load_lanes(q0, b0 + h);
+        load_lanes(q1, b1 + h);
+        load_lanes(q2, b2 + h);
+        q0 = q0 * t.inv_w[0];
+        q1 = q1 * t.inv_w[1];
+        q2 = q2 * t.inv_w[2];
+        const Lanes8 s = 1.0f / (q0 + q1 + q2);
+        const Lanes8 w1 = q1 * s, w2 = q2 * s;
+        for (int k = 0; k < NV; ++k) {
+            const Lanes8 v = p.v0[k] + w1 * p.d1[k] + w2 * p.d2[k];
+            store_lanes(in.var[k] + h, v);
+        }
+    }
+    in.centroid_mask = 0;
+    if (!MS) return;
+    const std::uint32_t off_centre = lanes & ~centre_coverage(t, bx, by);
+    if (!off_centre) return;
+    std::memcpy(in.centre_var, in.var, sizeof in.var);
+    in.centroid_mask = off_centre;
+    for (std::uint32_t m = off_centre; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        const int x = bx + lane_x(l), y = by + lane_y(l);
+        std::int64_t e0[3];
+        for (int e = 0; e < 3; ++e) e0[e] = edge_at_pixel(t, e, x, y);
+        // The centroid of the covered samples (inside the triangle, which is convex).
+        float sum_x = 0.0f, sum_y = 0.0f;
+        int n = 0;
+        for (int s = 0; s < sp.count; ++s) {
+            bool inside = true;
+            for (int e = 0; e < 3; ++e)
+                inside &= e0[e] + std::int64_t(t.A[e]) * sp.fixed_x(s) + std::int64_t(t.B[e]) * sp.fixed_y(s) >= 0;
+            if (!inside) continue;
+            sum_x += sp.pixel_x(s);
+            sum_y += sp.pixel_y(s);
+            ++n;
+        }
+        if (n == 0) continue;  // a live lane always has a covered sample; stay at the centre otherwise
+        const float dx = float(x - t.ax) + sum_x / float(n), dy = float(y - t.ay) + sum_y / float(n);
+        const float c0 = t.bary[0][0] + t.bary[0][1] * dx + t.bary[0][2] * dy;
+        const float c1 = t.bary[1][0] + t.bary[1][1] * dx + t.bary[1][2] * dy;
+        const float c2 = t.bary[2][0] + t.bary[2][1] * dx + t.bary[2][2] * dy;
+        interpolate_lane<NV>(t, p, c0, c1, c2, l, in);
+    }
+}
+
+// Colour of the lanes in `mask` (one sample plane, `row` pixels wide) from
+// the program's output.
+inline void write_color(float* color, std::size_t row, std::uint32_t mask, const FragmentOut& out, Blend blend) {
+    if (blend == Blend::Add) {
+        for (std::uint32_t m = mask; m; m &= m - 1) {
+            const int l = __builtin_ctz(m);
+            float* c = color + lane_offset_in(row, l) * 4;
+            c[0] += out.r[l]; c[1] += out.g[l]; c[2] += out.b[l]; c[3] += out.a[l];
+        }
+        return;
+    }
+    if (blend == Blend::Alpha) {
+        for (std::uint32_t m = mask; m; m &= m - 1) {
+            const int l = __builtin_ctz(m);
+            float* c = color + lane_offset_in(row, l) * 4;
+            const float a = out.a[l], keep = 1.0f - a;
+            c[0] = out.r[l] * a + c[0] * keep;
+            c[1] = out.g[l] * a + c[1] * keep;
+            c[2] = out.b[l] * a + c[2] * keep;
+            c[3] = out.a[l] * a + c[3] * keep;
+        }
+        return;
+    }
+    if (mask == 0xFFFFu) {
+        // Every pixel: lanes 2j and 2j + 1 are neighbours in a row, written
+        // as one pair of RGBA pixels.
+#if defined(__AVX2__)
+        for (int h = 0; h < kBlockLanes; h += 8) {
+            const __m256 r = _mm256_load_ps(out.r + h), g = _mm256_load_ps(out.g + h);
+            const __m256 b = _mm256_load_ps(out.b + h), a = _mm256_load_ps(out.a + h);
+            // Interleave: RGBA of lane h + i in the half of p[i % 4] given by i / 4.
+            const __m256d rg_lo = _mm256_castps_pd(_mm256_unpacklo_ps(r, g));
+            const __m256d ba_lo = _mm256_castps_pd(_mm256_unpacklo_ps(b, a));
+            const __m256d rg_hi = _mm256_castps_pd(_mm256_unpackhi_ps(r, g));
+            const __m256d ba_hi = _mm256_castps_pd(_mm256_unpackhi_ps(b, a));
+            const __m256 p0 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_lo, ba_lo));
+            const __m256 p1 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_lo, ba_lo));
+            const __m256 p2 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_hi, ba_hi));
+            const __m256 p3 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_hi, ba_hi));
+            _mm256_storeu_ps(color + lane_offset_in(row, h) * 4, _mm256_permute2f128_ps(p0, p1, 0x20));
+            _mm256_storeu_ps(color + lane_offset_in(row, h + 2) * 4, _mm256_permute2f128_ps(p2, p3, 0x20));
+            _mm256_storeu_ps(color + lane_offset_in(row, h + 4) * 4, _mm256_permute2f128_ps(p0, p1, 0x31));
+            _mm256_storeu_ps(color + lane_offset_in(row, h + 6) * 4, _mm256_permute2f128_ps(p2, p3, 0x31));
+        }
+#else
+        for (int l = 0; l < kBlockLanes; l += 2) {
+            const float pair[8] = {out.r[l], out.g[l], out.b[l], out.a[l],
+                                   out.r[l + 1], out.g[l + 1], out.b[l + 1], out.a[l + 1]};
+            std::memcpy(color + lane_offset_in(row, l) * 4, pair, sizeof pair);
+        }
+#endif
+        return;
+    }
+    for (std::uint32_t m = mask; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        float* c = color + lane_offset_in(row, l) * 4;
+        c[0] = out.r[l]; c[1] = out.g[l]; c[2] = out.b[l]; c[3] = out.a[l];
+    }
+}
+
+inline void count_quads(FrameStats& stats, std::uint32_t lanes) {
+    for (int q = 0; q < 4; ++q) stats.quads_shaded += ((lanes >> (4 * q)) & 0xFu) != 0;
+}
+
+// Depth test, shading and write-back of one covered block of a draw shaded
+// in submission order.
+template <bool MS, class Program, class Observer>
+void shade_in_order(const Program& program, const DrawState& st, const TriangleSetup& t,
+                    const TriangleVaryings<Program::kVaryings>& pv, TileContext& c, int bx, int by,
+                    BlockSamples& bs, Observer& obs) {
+    constexpr int NV = Program::kVaryings;
+    FrameStats& stats = *c.stats;
+    test_depth<MS>(t, c, bx, by, st.depth_test, Observer::enabled, bs);
+    count_fragments(stats, bs);
+    observe_fragments(obs, t, c, bx, by, bs);
+    if (!bs.any_pass) return;
+
+    FragmentBlock<NV> in;
+    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, bs.any_pass, MS ? nullptr : &bs, in);
+    in.x = bx;
+    in.y = by;
+    in.mask = bs.any_pass;
+    in.prim_id = t.prim_id;
+    in.front_facing = t.front_facing;
+    FragmentOut out;
+    out.kill = 0;
+    program.fragment(in, out);
+    const std::uint32_t live = bs.any_pass & ~out.kill;
+    count_quads(stats, bs.any_pass);
+    stats.fragments_shaded += popcount16(bs.any_pass);
+    stats.fragments_shader_killed += popcount16(bs.any_pass & out.kill);
+    stats.fragments_written += popcount16(live);
+    if constexpr (Observer::enabled) obs.shaded(in, out, live);
+
+    const TileTarget& tg = c.target;
+    const std::size_t o = tg.offset(bx, by);
+    for (int s = 0; s < samples_of<MS>(c); ++s) {
+        const std::uint32_t m = bs.pass[s] & live;
+        if (!m) continue;
+        if (st.depth_write) store_block(tg.depth + o + s * tg.plane, tg.row, m, bs.z[s]);
+        if (tg.color) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, st.blend);
+        if (tg.winner) store_winner(tg.winner + tg.winner_offset(bx, by) + s * tg.wplane, tg.wrow, m, kNoWinner);
+    }
+}
+
+// Shades the pixels `lanes` of a block for the triangle that won samples
+// `won[s]` there in the visibility pass, and writes those samples' colour.
+template <bool MS, class Program, class Observer>
+void shade_winner(const Program& program, const float* vertices, const BinJob& job, const TriangleSetup& t,
+                  TileContext& c, int bx, int by, std::uint32_t lanes, const std::uint32_t* won, Observer& obs) {
+    constexpr int NV = Program::kVaryings;
+    FrameStats& stats = *c.stats;
+    TriangleVaryings<NV> pv;
+    prepare_varyings<NV>(t, vertices, job, pv);
+    FragmentBlock<NV> in;
+    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, lanes, nullptr, in);
+    in.x = bx;
+    in.y = by;
+    in.mask = lanes;
+    in.prim_id = t.prim_id;
+    in.front_facing = t.front_facing;
+    FragmentOut out;
+    out.kill = 0;
+    program.fragment(in, out);
+    // A kill here breaks DrawState::may_discard's contract: honoured as
+    // "colour not written" (the depth was written in the visibility pass).
+    const std::uint32_t live = lanes & ~out.kill;
+    count_quads(stats, lanes);
+    stats.fragments_shaded += popcount16(lanes);
+    if constexpr (Observer::enabled) obs.shaded(in, out, live);
+
+    const TileTarget& tg = c.target;
+    const std::size_t o = tg.offset(bx, by);
+    for (int s = 0; s < samples_of<MS>(c); ++s) {
+        const std::uint32_t m = won[s] & live;
+        if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, Blend::Replace);
+    }
+}
+
+} // namespace detail
+} // namespace prast

@@ -1,0 +1,42 @@
+// The resolve stage: linear HDR radiance to the 8-bit output image, the last
+// step of conventions.md's "Output" (exposure, tone map, sRGB, rounding). It
+// runs vectorised (eight pixels at a time with AVX2) and, as a frame's tile
+// hook (TileResolve), on every thread inside the tile pass. Byte-identical to
+// the per-pixel reference (tonemap() then linear_to_srgb8()); tested.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "raster/frame.h"
+#include "shading/tonemap.h"
+
+namespace prast {
+
+// `count` RGBA pixels: rgb * exposure, tone map, sRGB encode, round to 8
+// bits; alpha floor(clamp(a, 0, 1) * 255 + 0.5), neither exposed nor encoded.
+void resolve_pixels_srgb8(const float* rgba, std::size_t count, float exposure, ToneMap tm, std::uint8_t* out);
+
+// Data (debug views) as is: clamp to [0, 1], * 255, round; alpha 255.
+void resolve_pixels_raw8(const float* rgba, std::size_t count, std::uint8_t* out);
+
+// A frame's tile hook writing the 8-bit image (rows of `width` pixels) from
+// each finished tile.
+struct TileResolve {
+    std::uint8_t* rgba8 = nullptr;
+    int width = 0;
+    float exposure = 1.0f;
+    ToneMap tonemap = ToneMap::Aces;
+    bool raw = false;  // data views: resolve_pixels_raw8
+
+    void operator()(const TileView& v) const {
+        for (int y = 0; y < v.height; ++y) {
+            const float* in = v.rgba + std::size_t(y) * v.row;
+            std::uint8_t* out = rgba8 + (std::size_t(v.y0 + y) * std::size_t(width) + std::size_t(v.x0)) * 4;
+            if (raw) resolve_pixels_raw8(in, std::size_t(v.width), out);
+            else resolve_pixels_srgb8(in, std::size_t(v.width), exposure, tonemap, out);
+        }
+    }
+};
+
+} // namespace prast

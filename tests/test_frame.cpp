@@ -1,0 +1,372 @@
+// Frames (raster/frame.h): a frame of many draws equals the same draws drawn
+// one by one; the visibility pass gives exactly the bytes of shading in
+// submission order (overdraw, equal depths, alpha-mask discards, double-sided
+// draws, blending in between) while shading each visible pixel once; alpha
+// blending and depth-only draws against hand-computed values; the tile hook
+// sees every pixel once with its final colour; bad frame use is refused.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <mutex>
+#include <stdexcept>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "tests/raster_test_util.h"
+
+using namespace prast;
+using namespace prast::test;
+
+namespace {
+
+// splitmix64: the same numbers on every platform.
+struct Random {
+    std::uint64_t s;
+    explicit Random(std::uint64_t seed) : s(seed) {}
+    std::uint64_t next() {
+        std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    double uniform() { return double(next() >> 11) * (1.0 / 9007199254740992.0); }
+    double range(double a, double b) { return a + (b - a) * uniform(); }
+};
+
+glm::vec4 at(double x, double y, int W, int H, double z_ndc = 0.0, double w = 1.0) {
+    return {float((x / W * 2.0 - 1.0) * w), float((1.0 - y / H * 2.0) * w), float(z_ndc * w), float(w)};
+}
+
+// Colour from three varyings plus their derivatives (so helper lanes matter),
+// and optionally a discard pattern and a translucent alpha.
+struct PaintProgram {
+    static constexpr int kVaryings = 3;
+    const glm::vec4* clip = nullptr;
+    const float* varyings = nullptr;
+    bool discard = false;
+    float alpha = 1.0f;
+    void vertex(std::uint32_t i, float out[4], float* var) const {
+        out[0] = clip[i].x; out[1] = clip[i].y; out[2] = clip[i].z; out[3] = clip[i].w;
+        for (int k = 0; k < 3; ++k) var[k] = varyings[3 * i + std::uint32_t(k)];
+    }
+    void fragment(const FragmentBlock<3>& in, FragmentOut& out) const {
+        out.kill = 0;
+        for (int l = 0; l < kBlockLanes; ++l) {
+            out.r[l] = in.var[0][l] + 8.0f * in.ddx(0, l);
+            out.g[l] = in.var[1][l] + 8.0f * in.ddy(1, l);
+            out.b[l] = in.var[2][l] * (in.front_facing ? 1.0f : 0.5f);
+            out.a[l] = alpha;
+            // Discard a pattern that depends on the varyings, like an alpha mask.
+            if (discard && std::fmod(std::fabs(in.var[0][l] * 7.0f + in.var[1][l] * 5.0f), 1.0f) < 0.3f)
+                out.kill |= 1u << l;
+        }
+    }
+};
+
+// A depth-only program: no fragment().
+struct DepthProgram {
+    static constexpr int kVaryings = 0;
+    const glm::vec4* clip = nullptr;
+    void vertex(std::uint32_t i, float out[4], float*) const {
+        out[0] = clip[i].x; out[1] = clip[i].y; out[2] = clip[i].z; out[3] = clip[i].w;
+    }
+};
+
+struct Draw {
+    std::vector<std::uint32_t> idx;
+    DrawState state;
+    bool discard = false, depth_only = false;
+    float alpha = 1.0f;
+};
+
+// Overlapping triangles at random depths (with exact ties: some triangles
+// are drawn twice, or share a plane), in several draws of different kinds.
+struct OverdrawScene {
+    int W, H;
+    std::vector<glm::vec4> clip;
+    std::vector<float> var;
+    std::vector<Draw> draws;
+
+    OverdrawScene(int w, int h, std::uint64_t seed, bool with_blending) : W(w), H(h) {
+        Random rng(seed);
+        auto tri = [&](std::vector<std::uint32_t>& idx, double size) {
+            const double cx = rng.range(-0.1, 1.1) * W, cy = rng.range(-0.1, 1.1) * H;
+            const double z = rng.range(-0.9, 0.9);
+            const bool flat = rng.uniform() < 0.3;  // equal depth at every pixel: ties
+            for (int k = 0; k < 3; ++k) {
+                const double zk = flat ? std::floor(z * 8.0) / 8.0 : z + rng.range(-0.3, 0.3);
+                clip.push_back(at(cx + rng.range(-size, size), cy + rng.range(-size, size), W, H, zk,
+                                  rng.range(0.5, 2.0)));
+                var.insert(var.end(), {float(rng.uniform()), float(rng.uniform()), float(rng.uniform())});
+            }
+            const std::uint32_t b = std::uint32_t(clip.size() - 3);
+            idx.insert(idx.end(), {b, b + 1, b + 2});
+            if (rng.uniform() < 0.1) idx.insert(idx.end(), {b, b + 1, b + 2});  // the same triangle again
+        };
+        for (int d = 0; d < 7; ++d) {
+            Draw dr;
+            const int n = d == 0 ? 2600 : 300;  // the first draw spans several binning jobs
+            for (int i = 0; i < n; ++i) tri(dr.idx, d == 0 ? rng.range(3.0, 30.0) : rng.range(10.0, 120.0));
+            dr.state.cull = d % 2 ? CullMode::None : CullMode::Back;  // double-sided draws
+            if (d == 2) {  // alpha MASK
+                dr.discard = true;
+                dr.state.may_discard = true;
+            }
+            if (d == 3) dr.depth_only = true;
+            if (d == 4) dr.state.depth_write = false;
+            if (d == 5 && with_blending) {
+                dr.state.blend = Blend::Alpha;
+                dr.state.depth_write = false;
+                dr.alpha = 0.375f;
+            }
+            draws.push_back(dr);
+        }
+    }
+
+    void submit(Renderer& r) const {
+        for (const Draw& d : draws) {
+            if (d.depth_only) {
+                DepthProgram p{clip.data()};
+                r.submit(p, std::uint32_t(clip.size()), d.idx.data(), d.idx.size(), d.state);
+            } else {
+                PaintProgram p{clip.data(), var.data(), d.discard, d.alpha};
+                r.submit(p, std::uint32_t(clip.size()), d.idx.data(), d.idx.size(), d.state);
+            }
+        }
+    }
+    void draw_one_by_one(Renderer& r, Framebuffer& fb) const {
+        for (const Draw& d : draws) {
+            if (d.depth_only) {
+                DepthProgram p{clip.data()};
+                r.draw(fb, p, std::uint32_t(clip.size()), d.idx.data(), d.idx.size(), d.state);
+            } else {
+                PaintProgram p{clip.data(), var.data(), d.discard, d.alpha};
+                r.draw(fb, p, std::uint32_t(clip.size()), d.idx.data(), d.idx.size(), d.state);
+            }
+        }
+    }
+};
+
+FrameOptions frame_options(FrameOptions::Visibility v, int samples = 1) {
+    FrameOptions o;
+    o.visibility = v;
+    o.samples = samples;
+    o.clear_color[0] = 0.25f; o.clear_color[1] = 0.5f; o.clear_color[2] = 0.125f; o.clear_color[3] = 1.0f;
+    o.clear_depth = 1.0f;
+    return o;
+}
+
+std::uint64_t render_frame(const OverdrawScene& sc, int threads, int tile, FrameOptions::Visibility v,
+                           FrameStats* stats = nullptr, int samples = 1) {
+    Renderer r({threads, tile});
+    Framebuffer fb(sc.W, sc.H);
+    r.begin_frame();
+    r.begin(fb, frame_options(v, samples));
+    sc.submit(r);
+    r.end();
+    if (stats) *stats = r.stats();
+    return hash_framebuffer(fb);
+}
+
+} // namespace
+
+TEST_SUITE("frame") {
+
+TEST_CASE("frame: many draws in one frame equal the same draws drawn one by one") {
+    const OverdrawScene sc(203, 131, 7, true);
+    // Draw by draw over a cleared target, shading in order: the old path.
+    Renderer r({2, 64});
+    Framebuffer fb(sc.W, sc.H);
+    fb.clear(0.25f, 0.5f, 0.125f, 1.0f);
+    sc.draw_one_by_one(r, fb);
+    const std::uint64_t ref = hash_framebuffer(fb);
+    for (int threads : {1, 2, 3, 8})
+        for (int tile : {16, 32, 64, 128, 256})
+            for (auto v : {FrameOptions::Visibility::Auto, FrameOptions::Visibility::Always,
+                           FrameOptions::Visibility::Never}) {
+                CAPTURE(threads);
+                CAPTURE(tile);
+                CAPTURE(int(v));
+                CHECK(render_frame(sc, threads, tile, v) == ref);
+            }
+}
+
+TEST_CASE("visibility: byte-identical to shading in order, each visible pixel shaded once") {
+    for (bool blending : {false, true}) {
+        CAPTURE(blending);
+        const OverdrawScene sc(256, 160, 11 + blending, blending);
+        FrameStats in_order, visible, automatic;
+        const std::uint64_t ref = render_frame(sc, 1, 64, FrameOptions::Visibility::Never, &in_order);
+        CHECK(render_frame(sc, 2, 32, FrameOptions::Visibility::Always, &visible) == ref);
+        CHECK(render_frame(sc, 3, 128, FrameOptions::Visibility::Auto, &automatic) == ref);
+        // The depth test saw the same fragments in the same order.
+        CHECK(visible.fragments_covered == in_order.fragments_covered);
+        CHECK(visible.fragments_depth_killed == in_order.fragments_depth_killed);
+        CHECK(visible.fragments_written == in_order.fragments_written);
+        CHECK(visible.fragments_shader_killed == in_order.fragments_shader_killed);
+        // Heavy overdraw and discards were exercised.
+        CHECK(in_order.fragments_written > 3u * 256u * 160u);
+        CHECK(in_order.fragments_shader_killed > 1000u);
+        CHECK(in_order.fragments_depth_killed > 10000u);
+        // Through the visibility pass far fewer fragments were shaded.
+        CHECK(visible.fragments_shaded * 2 < in_order.fragments_shaded);
+    }
+}
+
+TEST_CASE("visibility: a single opaque draw shades each covered pixel exactly once") {
+    // Without discards or blending, the shader runs once per visible pixel:
+    // fragments_shaded equals the number of pixels that end up covered.
+    const OverdrawScene sc(160, 120, 5, false);
+    Renderer r({2, 32});
+    Framebuffer fb(sc.W, sc.H);
+    FrameOptions o = frame_options(FrameOptions::Visibility::Always);
+    r.begin_frame();
+    r.begin(fb, o);
+    PaintProgram p{sc.clip.data(), sc.var.data(), false, 1.0f};
+    r.submit(p, std::uint32_t(sc.clip.size()), sc.draws[0].idx.data(), sc.draws[0].idx.size(), sc.draws[0].state);
+    r.end();
+    std::uint64_t covered = 0;
+    for (float d : fb.depth) covered += d < 1.0f;
+    CHECK(covered > 5000u);
+    CHECK(r.stats().fragments_shaded == covered);
+    CHECK(r.stats().fragments_written > covered);
+}
+
+TEST_CASE("blend: alpha over a known background is src * a + dst * (1 - a), depth tested, not written") {
+    const int W = 32, H = 32;
+    // An opaque quad in the left half at z_ndc 0 (window depth 0.5), then a
+    // blended full-screen quad at z_ndc 0.5 (0.75): behind the opaque one, in
+    // front of the background.
+    std::vector<glm::vec4> clip = {at(0, 0, W, H, 0.0), at(0, H, W, H, 0.0), at(16, H, W, H, 0.0), at(16, 0, W, H, 0.0),
+                                   at(0, 0, W, H, 0.5), at(0, H, W, H, 0.5), at(W, H, W, H, 0.5), at(W, 0, W, H, 0.5)};
+    std::vector<float> var = {0.5f, 0.25f, 1.0f, 0.5f, 0.25f, 1.0f, 0.5f, 0.25f, 1.0f, 0.5f, 0.25f, 1.0f,
+                              1.0f, 0.75f, 0.0f, 1.0f, 0.75f, 0.0f, 1.0f, 0.75f, 0.0f, 1.0f, 0.75f, 0.0f};
+    const std::vector<std::uint32_t> opaque = {0, 1, 2, 0, 2, 3}, glass = {4, 5, 6, 4, 6, 7};
+    for (int samples : {1, 4}) {
+        CAPTURE(samples);
+        Renderer r({2, 16});
+        Framebuffer fb(W, H);
+        FrameOptions o;
+        o.samples = samples;
+        o.clear_color[0] = 0.0f; o.clear_color[1] = 0.5f; o.clear_color[2] = 1.0f; o.clear_color[3] = 1.0f;
+        r.begin(fb, o);
+        PaintProgram solid{clip.data(), var.data(), false, 1.0f};
+        PaintProgram tinted{clip.data(), var.data(), false, 0.25f};
+        DrawState blend;
+        blend.blend = Blend::Alpha;
+        blend.depth_write = false;
+        r.submit(solid, std::uint32_t(clip.size()), opaque.data(), opaque.size());
+        r.submit(tinted, std::uint32_t(clip.size()), glass.data(), glass.size(), blend);
+        r.end();
+        // Left: the opaque quad (r = 0.5 + 8 * ddx = 0.5: constant varyings), untouched.
+        const float* left = fb.pixel(5, 10);
+        CHECK(left[0] == 0.5f);
+        CHECK(left[1] == 0.25f);
+        CHECK(left[2] == 1.0f);
+        CHECK(fb.depth[10 * W + 5] == 0.5f);
+        // Right: (1, 0.75, 0, a 0.25) over (0, 0.5, 1, 1).
+        const float* right = fb.pixel(25, 10);
+        CHECK(right[0] == 1.0f * 0.25f + 0.0f * 0.75f);
+        CHECK(right[1] == 0.75f * 0.25f + 0.5f * 0.75f);
+        CHECK(right[2] == 0.0f * 0.25f + 1.0f * 0.75f);
+        CHECK(right[3] == 0.25f * 0.25f + 1.0f * 0.75f);
+        CHECK(fb.depth[10 * W + 25] == 1.0f);  // not written
+    }
+}
+
+TEST_CASE("depth only: a program without fragment() writes depth and leaves colour alone") {
+    const int W = 40, H = 24;
+    // A plane whose NDC depth runs from -0.5 at the left edge to 0.5 at the right.
+    std::vector<glm::vec4> clip = {at(0, 0, W, H, -0.5), at(0, H, W, H, -0.5), at(W, H, W, H, 0.5), at(W, 0, W, H, 0.5)};
+    const std::vector<std::uint32_t> idx = {0, 1, 2, 0, 2, 3};
+    DepthProgram p{clip.data()};
+    for (int samples : {1, 4}) {
+        CAPTURE(samples);
+        Renderer r({2, 16});
+        // A depth target (no colour), and a colour target whose colour must survive.
+        Framebuffer shadow = Framebuffer::depth_only(W, H);
+        Framebuffer both(W, H);
+        both.clear(0.125f, 0.25f, 0.375f, 0.5f);
+        FrameOptions o;
+        o.samples = samples;
+        r.begin(shadow, o);
+        r.submit(p, 4, idx.data(), idx.size());
+        r.end();
+        FrameOptions keep = o;
+        keep.clear = false;
+        r.begin(both, keep);
+        r.submit(p, 4, idx.data(), idx.size());
+        r.end();
+        CHECK(shadow.color.empty());
+        int bad_depth = 0, bad_color = 0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                // Window depth at the pixel centre: (z_ndc + 1) / 2 with z_ndc
+                // linear in x; the nearest sample's with several samples.
+                const double nearest_x = samples == 1 ? x + 0.5 : x + 0.5 - 6.0 / 16.0;
+                const double expect = 0.25 + 0.5 * nearest_x / W;
+                const float d = shadow.depth[std::size_t(y) * W + x];
+                bad_depth += std::fabs(d - expect) > 1e-6;
+                bad_depth += both.depth[std::size_t(y) * W + x] != d;
+                const float* c = both.pixel(x, y);
+                bad_color += c[0] != 0.125f || c[1] != 0.25f || c[2] != 0.375f || c[3] != 0.5f;
+            }
+        CHECK(bad_depth == 0);
+        CHECK(bad_color == 0);
+    }
+}
+
+TEST_CASE("frame: the tile hook sees every pixel once, with its final colour") {
+    const OverdrawScene sc(150, 97, 3, true);
+    for (int samples : {1, 4}) {
+        for (int tile : {16, 64}) {
+            CAPTURE(samples);
+            CAPTURE(tile);
+            Renderer r({3, tile});
+            Framebuffer fb(sc.W, sc.H);
+            std::vector<float> seen(fb.color.size(), -1.0f);
+            std::vector<int> count(std::size_t(sc.W) * sc.H, 0);
+            std::mutex m;
+            r.begin(fb, frame_options(FrameOptions::Visibility::Auto, samples));
+            sc.submit(r);
+            r.end([&](const TileView& v) {
+                std::lock_guard<std::mutex> lock(m);
+                for (int y = 0; y < v.height; ++y)
+                    for (int x = 0; x < v.width; ++x) {
+                        const std::size_t p = std::size_t(v.y0 + y) * sc.W + std::size_t(v.x0 + x);
+                        ++count[p];
+                        for (int c = 0; c < 4; ++c) seen[p * 4 + std::size_t(c)] = v.rgba[std::size_t(y) * v.row + 4 * std::size_t(x) + std::size_t(c)];
+                    }
+            });
+            int not_once = 0;
+            for (int n : count) not_once += n != 1;
+            CHECK(not_once == 0);
+            CHECK(seen == fb.color);
+        }
+    }
+}
+
+TEST_CASE("frame: misuse is refused") {
+    Renderer r({1, 16});
+    Framebuffer fb(8, 8);
+    CountProgram p;
+    std::vector<glm::vec4> clip = {glm::vec4(0, 0, 0, 1)};
+    CHECK_THROWS_AS(r.submit(p, 1, nullptr, 0), std::logic_error);
+    CHECK_THROWS_AS(r.end(), std::logic_error);
+    FrameOptions bad;
+    bad.samples = 3;
+    CHECK_THROWS_AS(r.begin(fb, bad), std::invalid_argument);
+    r.begin(fb);
+    CHECK_THROWS_AS(r.begin(fb), std::logic_error);
+    r.end();
+    Framebuffer empty;
+    CHECK_THROWS_AS(r.begin(empty), std::invalid_argument);
+    // The renderer is still usable.
+    r.begin(fb);
+    r.end();
+    CHECK(fb.depth[0] == 1.0f);
+}
+
+} // TEST_SUITE
