@@ -15,6 +15,7 @@
 
 #include <stb_image_write.h>
 
+#include "fuzz/png_craft.h"
 #include "fuzz/targets.h"
 
 namespace fs = std::filesystem;
@@ -61,6 +62,32 @@ void image_seeds() {
                                     "q" + std::to_string(quality) + ".jpg", jpg);
                 }
         }
+    // PNGs of the kinds stb_image_write never makes, which take libpng's path
+    // or the 16-bit one (fuzz/png_craft.h): every bit depth of grey, 16-bit
+    // grey+alpha and RGBA, palettes of 1 to 8 bits with and without tRNS,
+    // tRNS on grey and RGB, Adam7 interlacing.
+    namespace pc = prast::png_craft;
+    const auto wave = [](int x, int y) { return std::uint64_t(x * 2654435761u ^ y * 40503u); };
+    for (int depth : {1, 2, 4, 8, 16})
+        put("png", "grey" + std::to_string(depth) + ".png", pc::file(9, 5, depth, 0, 0, depth, wave));
+    put("png", "grey16-alpha.png", pc::file(7, 3, 16, 4, 0, 32, wave));
+    put("png", "rgba16.png", pc::file(5, 4, 16, 6, 0, 64, wave));
+    put("png", "rgb16-interlaced.png", pc::file(9, 9, 16, 2, 1, 48, wave));
+    std::string plte;
+    for (int i = 0; i < 256; ++i) plte += {char(i), char(255 - i), char(i * 7)};
+    for (int depth : {1, 2, 4, 8}) {
+        const std::string palette = pc::chunk("PLTE", plte.substr(0, std::size_t(3) << depth));
+        put("png", "palette" + std::to_string(depth) + ".png", pc::file(10, 6, depth, 3, 0, depth, wave, palette));
+        put("png", "palette" + std::to_string(depth) + "-trns.png",
+            pc::file(10, 6, depth, 3, 0, depth, wave, palette + pc::chunk("tRNS", std::string("\x00\x80\xff", 3))));
+    }
+    put("png", "grey8-trns.png", pc::file(6, 6, 8, 0, 0, 8, wave, pc::chunk("tRNS", std::string("\x00\x07", 2))));
+    put("png", "rgb8-trns.png", pc::file(6, 6, 8, 2, 0, 24, wave, pc::chunk("tRNS", std::string("\x00\x07\x00\x09\x00\x0b", 6))));
+    put("png", "rgb8-interlaced.png", pc::file(13, 11, 8, 2, 1, 24, wave));
+    put("png", "grey2-interlaced.png", pc::file(17, 3, 2, 0, 1, 2, wave));
+    put("png", "palette4-interlaced.png",
+        pc::file(12, 12, 4, 3, 1, 4, wave, pc::chunk("PLTE", plte.substr(0, 48))));
+
     // Radiance: width 8..32767 is written run-length encoded, below 8 flat.
     const int hdr_sizes[][2] = {{4, 3}, {8, 2}, {16, 4}, {40, 3}};
     for (const auto& s : hdr_sizes) {

@@ -44,6 +44,7 @@ float srgb_to_linear(float c) {
 std::string stbi_reason() {
     const char* r = stbi_failure_reason();
     if (r && std::string(r) == "outofmem") return "out of memory";
+    if (r && std::string(r) == "outofdata") return "truncated image data";
     return r ? r : "unknown error";
 }
 
@@ -59,6 +60,11 @@ const char* sniff_format(const unsigned char* p, std::size_t n) {
     if (starts("8BPS", 4)) return "PSD";
     if (starts("BM", 2)) return "BMP";
     return nullptr;
+}
+
+bool is_png(const unsigned char* p, std::size_t n) {
+    const char* format = sniff_format(p, n);
+    return format && std::strcmp(format, "PNG") == 0;
 }
 
 // Expands `comp` channels per texel to RGBA, decoding colour channels with
@@ -387,6 +393,40 @@ namespace {
 // Twice the densest JPEG possible (512 texels a byte, see decode_image).
 constexpr std::int64_t kMaxJpegTexelsPerByte = 1024;
 
+// Deflate's densest output: a 258-byte match costs at least 2 bits (a
+// length and a distance code), so 1032 bytes per compressed byte.
+constexpr std::int64_t kMaxDeflateRatio = 1032;
+
+// "" when a PNG's IDAT chunks can hold the pixels its header claims; else
+// why not. Checked before any decoder allocates the image: a 100-byte file
+// claiming 16384x16384 texels would otherwise cost a gigabyte of zeroed
+// memory before failing as truncated. The filtered rows hold at least
+// w * h * bits / 8 bytes (interlaced or not), and no more than
+// kMaxDeflateRatio bytes come from each compressed one.
+std::string png_data_shortfall(const unsigned char* data, std::size_t size, int w, int h) {
+    if (size < 8 + 25) return "";  // the decoders name a short file
+    const unsigned char* ihdr = data + 16;
+    static const int kSamples[7] = {1, 0, 3, 1, 2, 0, 4};
+    const int depth = ihdr[8], colour = ihdr[9];
+    if (colour > 6 || !kSamples[colour] || depth < 1 || depth > 16) return "";  // refused by the decoders
+    const std::int64_t bits = std::int64_t(kSamples[colour]) * depth;
+    const std::int64_t need = std::int64_t(w) * std::int64_t(h) * bits / 8;
+    std::int64_t idat = 0;
+    for (std::size_t pos = 8; pos + 12 <= size;) {
+        const std::uint32_t len = be32(data + pos);
+        if (len > size - pos - 12) {  // the last chunk cut short: count what is there
+            if (std::memcmp(data + pos + 4, "IDAT", 4) == 0) idat += std::int64_t(size - pos - 8);
+            break;
+        }
+        if (std::memcmp(data + pos + 4, "IDAT", 4) == 0) idat += len;
+        pos += 12 + std::size_t(len);
+    }
+    if (need <= kMaxDeflateRatio * idat + 1024) return "";
+    return std::to_string(w) + "x" + std::to_string(h) + " texels need at least " + std::to_string(need) +
+           " bytes of pixel data, and " + std::to_string(idat) + " compressed bytes hold at most " +
+           std::to_string(kMaxDeflateRatio * idat + 1024);
+}
+
 // "" when stb_image 2.27 may see these bytes; else "cannot decode FORMAT
 // image: why".
 std::string stb_unsafe(const unsigned char* data, std::size_t size) {
@@ -450,6 +490,11 @@ Image decode_image(const ImageSource& src, bool srgb) {
                         " texels from only " + std::to_string(bytes->size()) + " bytes (a JPEG holds at most " +
                         std::to_string(kMaxJpegTexelsPerByte) + " texels a byte)");
 
+    if (is_png(data, bytes->size())) {
+        const std::string shortfall = png_data_shortfall(data, bytes->size(), w, h);
+        if (!shortfall.empty()) throw LoadError(name + ": cannot decode PNG image: " + shortfall);
+    }
+
     // Decode with the file's own channel count.
     struct StbiFree {
         void operator()(void* p) const { stbi_image_free(p); }
@@ -457,7 +502,11 @@ Image decode_image(const ImageSource& src, bool srgb) {
     Image img;
     int dw = 0, dh = 0, dcomp = 0;
     auto check = [&](const void* pixels) {
-        if (!pixels) throw LoadError(name + ": cannot decode image: " + stbi_reason());
+        if (!pixels) {
+            const char* format = sniff_format(data, bytes->size());
+            throw LoadError(name + ": cannot decode " + (format ? format : "") + (format ? " " : "") +
+                            "image: " + stbi_reason());
+        }
         if (dw != w || dh != h || dcomp < 1 || dcomp > 4)
             throw LoadError(name + ": inconsistent image header");
         img.width = w;
@@ -479,7 +528,7 @@ Image decode_image(const ImageSource& src, bool srgb) {
         const auto decode = [](stbi_us c) { return srgb_to_linear(float(c) / 65535.0f); };
         if (srgb) expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), decode, linear);
         else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
-    } else if (sniff_format(data, bytes->size()) == std::string("PNG")) {
+    } else if (is_png(data, bytes->size())) {
         // 8-bit PNG: the bytes as the file has them; sampling decodes them.
         std::string error;
         const FastPng fast = decode_png_fast(data, bytes->size(), w, h, img, error);

@@ -23,6 +23,7 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <fcntl.h>
@@ -35,6 +36,7 @@
 #include <stb_image.h>
 #include <stb_image_write.h>
 
+#include "fuzz/png_craft.h"
 #include "fuzz/targets.h"
 #include "raster/thread_pool.h"
 #include "scene/file_access.h"
@@ -559,6 +561,356 @@ TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused be
     // Not JPEG data, even with the pair in it: no opinion.
     const unsigned char other[] = {0x89, 'P', 'N', 'G', 0xFF, 0xC4, 0, 3, 0, 255, 255};
     CHECK(check_jpeg_data(other, sizeof other) == "");
+}
+
+// ---------------------------------------------------------------- PNG
+
+namespace {
+
+// fuzz/png_craft.h under the names used below.
+using png_craft::zlib_stored;
+const std::string& kPngSignature = png_craft::kSignature;
+std::string png_chunk(const std::string& type, const std::string& data) { return png_craft::chunk(type, data); }
+std::string png_ihdr(std::uint32_t w, std::uint32_t h, int depth, int colour, int interlace = 0) {
+    return png_craft::ihdr(w, h, depth, colour, interlace);
+}
+std::string be32_bytes(std::uint32_t v) { return png_craft::be32(v); }
+std::string png_rows(int w, int h, int bits, bool interlaced, const std::function<std::uint64_t(int, int)>& sample) {
+    return png_craft::rows(w, h, bits, interlaced, sample);
+}
+
+std::vector<unsigned char> bytes_of(const std::string& s) { return {s.begin(), s.end()}; }
+
+// decode_image on `png` named `name`: "" when it decodes, else the message.
+std::string png_error(const std::string& name, const std::string& png) {
+    ImageSource src;
+    src.name = name;
+    src.bytes = bytes_of(png);
+    try {
+        decode_image(src, false);
+        return "";
+    } catch (const LoadError& e) {
+        return e.what();
+    }
+}
+
+} // namespace
+
+TEST_CASE("PNG kinds beyond the fast path decode to the right texels: interlaced, 16-bit, palette, 1-bit, tRNS") {
+    const int w = 13, h = 11;
+    const auto rgb = [](int x, int y) { return std::uint64_t((x * 19) & 0xFF) << 16 | std::uint64_t((y * 23) & 0xFF) << 8 | std::uint64_t((x * y) & 0xFF); };
+    ImageSource src;
+    src.name = "kinds.png";
+    // Adam7 RGB: the same texels as the plain file (which takes the fast path).
+    for (int interlace : {0, 1}) {
+        CAPTURE(interlace);
+        src.bytes = bytes_of(kPngSignature + png_ihdr(w, h, 8, 2, interlace) +
+                             png_chunk("IDAT", zlib_stored(png_rows(w, h, 24, interlace == 1, rgb))) +
+                             png_chunk("IEND", ""));
+        const Image img = decode_image(src, false);
+        REQUIRE(img.width == w);
+        REQUIRE(img.height == h);
+        REQUIRE(img.channels == 3);
+        bool same = true;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (int c = 0; c < 3; ++c)
+                    same = same && img.pixels[(std::size_t(y) * w + x) * 3 + c] == ((rgb(x, y) >> (16 - 8 * c)) & 0xFF);
+        CHECK(same);
+    }
+    // 16-bit grey+alpha: linear floats v / 65535.
+    const auto ga16 = [](int x, int y) { return std::uint64_t(x * 5000 + y) << 16 | std::uint64_t(65535 - y * 999); };
+    src.bytes = bytes_of(kPngSignature + png_ihdr(w, h, 16, 4) +
+                         png_chunk("IDAT", zlib_stored(png_rows(w, h, 32, false, ga16))) + png_chunk("IEND", ""));
+    {
+        const Image img = decode_image(src, false);
+        REQUIRE(img.channels == 0);
+        CHECK(img.at(7, 3).x == doctest::Approx((7 * 5000 + 3) / 65535.0).epsilon(1e-6));
+        CHECK(img.at(7, 3).w == doctest::Approx((65535 - 3 * 999) / 65535.0).epsilon(1e-6));
+    }
+    // A 4-bit palette, then the same with tRNS (alpha per entry).
+    std::string plte;
+    for (int i = 0; i < 16; ++i) plte += {char(i * 16), char(255 - i * 16), char(i * 3)};
+    const auto index = [](int x, int y) { return std::uint64_t((x + 3 * y) % 16); };
+    const std::string pixels = png_chunk("IDAT", zlib_stored(png_rows(w, h, 4, false, index)));
+    for (bool trns : {false, true}) {
+        CAPTURE(trns);
+        src.bytes = bytes_of(kPngSignature + png_ihdr(w, h, 4, 3) + png_chunk("PLTE", plte) +
+                             (trns ? png_chunk("tRNS", std::string("\x00\x40\x80", 3)) : std::string()) + pixels +
+                             png_chunk("IEND", ""));
+        const Image img = decode_image(src, false);
+        REQUIRE(img.channels == (trns ? 4 : 3));
+        const std::size_t at = (std::size_t(5) * w + 4) * std::size_t(img.channels);  // index (4 + 15) % 16 = 3
+        CHECK(int(img.pixels[at]) == 48);
+        CHECK(int(img.pixels[at + 1]) == 207);
+        CHECK(int(img.pixels[at + 2]) == 9);
+        if (trns) {
+            CHECK(int(img.pixels[3]) == 0);        // index 0: alpha 0
+            CHECK(int(img.pixels[at + 3]) == 255);  // index 3: past the tRNS entries
+        }
+    }
+    // 1-bit grey: 0 or 255.
+    src.bytes = bytes_of(kPngSignature + png_ihdr(w, h, 1, 0) +
+                         png_chunk("IDAT", zlib_stored(png_rows(w, h, 1, false, [](int x, int y) { return std::uint64_t((x + y) & 1); }))) +
+                         png_chunk("IEND", ""));
+    {
+        const Image img = decode_image(src, false);
+        REQUIRE(img.channels == 1);
+        CHECK(int(img.pixels[0]) == 0);
+        CHECK(int(img.pixels[1]) == 255);
+        CHECK(int(img.pixels[std::size_t(w)]) == 255);
+    }
+}
+
+TEST_CASE("hostile PNGs: one clean line naming the file and the problem, never a crash, a hang or a huge allocation") {
+    const int w = 16, h = 8;
+    const auto grey = [](int x, int y) { return std::uint64_t((x * 16 + y) & 0xFF); };
+    const std::string rows = png_rows(w, h, 8, false, grey);
+    const std::string head = kPngSignature + png_ihdr(w, h, 8, 0);
+    const std::string good = head + png_chunk("IDAT", zlib_stored(rows)) + png_chunk("IEND", "");
+    REQUIRE(png_error("good.png", good) == "");
+    const std::string interlaced_head = kPngSignature + png_ihdr(w, h, 8, 0, 1);
+    const std::string interlaced_idat = png_chunk("IDAT", zlib_stored(png_rows(w, h, 8, true, grey)));
+    REQUIRE(png_error("good.png", interlaced_head + interlaced_idat + png_chunk("IEND", "")) == "");
+
+    std::string bad_crc = good;
+    bad_crc[head.size() + 8 + 20] ^= 0x10;  // a pixel byte inside the IDAT data
+    std::string bad_crc_interlaced = interlaced_head + interlaced_idat;
+    bad_crc_interlaced[interlaced_head.size() + 8 + 20] ^= 0x10;
+    std::string bad_zlib_block = zlib_stored(rows);
+    bad_zlib_block[2] = 0x07;  // block type 3: reserved
+    std::string short_stream = zlib_stored(rows.substr(0, rows.size() / 2));
+    const std::string absurd_length = be32_bytes(0x7FFFFFF0) + "tEXt" + "Comment";
+
+    // name, file, what the message must say after "NAME: cannot decode PNG image: "
+    const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
+        {"truncated-idat.png", good.substr(0, head.size() + 8 + 40), "truncated file"},
+        {"truncated-interlaced.png", (interlaced_head + interlaced_idat).substr(0, interlaced_head.size() + 8 + 40), "truncated file"},
+        {"huge-ihdr.png", kPngSignature + png_ihdr(16384, 16384, 8, 6) + png_chunk("IDAT", zlib_stored(rows)) + png_chunk("IEND", ""),
+         "16384x16384 texels need at least 1073741824 bytes of pixel data, and 147 compressed bytes hold at most 152728"},
+        {"huge-palette.png", kPngSignature + png_ihdr(16384, 16384, 1, 3) + png_chunk("PLTE", std::string(6, '\x7f')) + png_chunk("IDAT", zlib_stored(rows)) + png_chunk("IEND", ""),
+         "16384x16384 texels need at least 33554432 bytes"},
+        {"bad-crc.png", bad_crc, "CRC error in the IDAT chunk"},
+        {"bad-crc-interlaced.png", bad_crc_interlaced, "IDAT"},
+        {"bad-zlib-header.png", head + png_chunk("IDAT", "\x78\x02" + rows) + png_chunk("IEND", ""), "bad zlib header"},
+        {"bad-zlib-block.png", head + png_chunk("IDAT", bad_zlib_block) + png_chunk("IEND", ""), "corrupt image data (zlib: invalid block type)"},
+        {"short-zlib-stream.png", head + png_chunk("IDAT", short_stream) + png_chunk("IEND", ""), "not enough image data"},
+        {"absurd-chunk-length.png", head + absurd_length + png_chunk("IDAT", zlib_stored(rows)), "truncated file"},
+        {"absurd-idat-length.png", head + be32_bytes(0xFFFFFFFF) + "IDAT" + zlib_stored(rows), "PNG unsigned integer out of range"},
+        {"empty-idat.png", head + png_chunk("IDAT", "") + png_chunk("IEND", ""), "truncated image data"},
+        {"no-idat.png", head + png_chunk("IEND", ""), "IEND: out of place"},
+        {"palette-without-plte.png", kPngSignature + png_ihdr(w, h, 8, 3) + png_chunk("IDAT", zlib_stored(rows)) + png_chunk("IEND", ""), "corrupt or truncated header"},
+        {"bad-bit-depth.png", kPngSignature + png_ihdr(w, h, 5, 0) + png_chunk("IDAT", zlib_stored(rows)) + png_chunk("IEND", ""), "corrupt or truncated header"},
+        {"truncated-16-bit.png", (kPngSignature + png_ihdr(w, h, 16, 0) + png_chunk("IDAT", zlib_stored(png_rows(w, h, 16, false, grey)))).substr(0, 90), "truncated image data"},
+        {"zero-width.png", kPngSignature + png_ihdr(0, h, 8, 0) + png_chunk("IDAT", zlib_stored(rows)) + png_chunk("IEND", ""), "corrupt or truncated header"},
+        {"width-2-to-31.png", kPngSignature + png_ihdr(0x80000000u, 1, 8, 0) + png_chunk("IDAT", zlib_stored(rows)) + png_chunk("IEND", ""), "corrupt or truncated header"},
+        {"bad-filter.png", head + png_chunk("IDAT", zlib_stored(std::string(1, '\x09') + rows.substr(1))) + png_chunk("IEND", ""), "bad row filter type 9"},
+    };
+    for (const auto& [name, file, why] : cases) {
+        CAPTURE(name);
+        std::string message;
+        // In a child under a watchdog: a crash or a hang fails the case.
+        const int code = in_child([&, name = name, file = file, why = why] {
+            const std::string m = png_error(name, file);
+            if (m.empty()) return 10;                                  // decoded from bad data
+            if (m.find('\n') != std::string::npos) return 11;          // one line
+            if (m.rfind(name + ": ", 0) != 0) return 12;               // names the file
+            if (m.find(why) == std::string::npos) return 13;           // names the problem
+            return 0;
+        }, 30);
+        CHECK(code == 0);
+        if (code != 0) MESSAGE(png_error(name, file));
+    }
+}
+
+TEST_CASE("a huge PNG header with little data is refused from the chunk lengths, also through render") {
+    CliSandbox box;
+    std::string rows(17, '\0');
+    const std::string png = kPngSignature + png_ihdr(16384, 16384, 8, 6) + png_chunk("IDAT", zlib_stored(rows)) +
+                            png_chunk("IEND", "");
+    test::write_bytes(box.path("huge.png"), bytes_of(png));
+    write_text(box.path("m.mtl"), "newmtl a\nmap_Kd huge.png\n");
+    write_text(box.path("m.obj"), kTriangleObj);
+    // The check comes before any decoder allocates the 1 GiB image.
+    const CliRun r = render(box, with({"m.obj", "-o", "o.png"}, kSmall));
+    CHECK(r.code == 0);
+    CHECK(lines_of(r.err).size() == 1);
+    CHECK(has_line_with(r.err, "huge.png: cannot decode PNG image: 16384x16384 texels need at least 1073741824 bytes",
+                        "(texture ignored)"));
+}
+
+TEST_CASE("other formats stb_image reads (TGA) decode without a PNG signature to compare against") {
+    // sniff_format() names no format for TGA: that path once compared a null
+    // pointer with a string.
+    std::vector<unsigned char> tga;
+    const unsigned char px[2 * 2 * 3] = {255, 0, 0, 0, 255, 0, 0, 0, 255, 9, 9, 9};
+    stbi_write_tga_to_func(
+        [](void* ctx, void* data, int size) {
+            auto* o = static_cast<std::vector<unsigned char>*>(ctx);
+            o->insert(o->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
+        },
+        &tga, 2, 2, 3, px);
+    ImageSource src;
+    src.name = "t.tga";
+    src.bytes = tga;
+    const Image img = decode_image(src, false);
+    REQUIRE(img.channels == 3);
+    CHECK(std::vector<unsigned char>(img.pixels.begin(), img.pixels.end()) ==
+          std::vector<unsigned char>(px, px + sizeof px));
+}
+
+// ---------------------------------------------------------------- step and prast-diff
+
+namespace {
+
+// step with a watchdog, like render() above.
+CliRun step(const CliSandbox& box, const std::vector<std::string>& args, const std::string& setup = "") {
+    std::vector<std::string> all = {"-s", "KILL", "60", PRAST_STEP_EXE};
+    all.insert(all.end(), args.begin(), args.end());
+    return box.run_exe("timeout", all, setup);
+}
+
+CliRun prast_diff(const CliSandbox& box, const std::vector<std::string>& args) {
+    std::vector<std::string> all = {"-s", "KILL", "60", PRAST_DIFF_EXE};
+    all.insert(all.end(), args.begin(), args.end());
+    return box.run_exe("timeout", all);
+}
+
+const std::vector<std::string> kStepSmall = {"--size", "48x48", "--sun", "0,0,1:1,1,1", "--pixel", "24,24"};
+
+} // namespace
+
+TEST_CASE("step loads scenes under render's rules: confined references, FIFOs, accessor budgets, hostile images") {
+    CliSandbox box;
+    fs::create_directories(box.work() / "model");
+    write_png(box.path("secret.png"), 4, 4, 255, 0, 0);
+    write_png(box.path("model/t.png"), 4, 4, 255, 0, 0);
+    REQUIRE(mkfifo(box.path("model/fifo.png").c_str(), 0600) == 0);
+    // OBJ+MTL: the texture outside the folder, a FIFO, and one inside that loads.
+    write_text(box.path("model/m.mtl"), "newmtl a\nmap_Kd ../secret.png\nmap_Ke fifo.png\nmap_Pr t.png\n");
+    write_text(box.path("model/m.obj"), kTriangleObj);
+    CliRun r = step(box, with({"model/m.obj"}, kStepSmall));
+    CHECK(r.code == 0);
+    CHECK(has_line_with(r.err, "step: warning: ", "map_Kd '../secret.png' refused: climbs out of the model's folder"));
+    CHECK(has_line_with(r.err, "step: warning: ", "map_Ke 'fifo.png' refused: not a regular file (a FIFO)"));
+    CHECK(lines_of(r.err).size() == 2);
+    CHECK(r.out.rfind("pixel 24 24: ", 0) == 0);
+    CHECK(r.err.find("--allow-outside-paths") == std::string::npos);  // step does not take it
+
+    // glTF: a buffer outside the folder is an error, as in render.
+    std::vector<unsigned char> four(4, 0);
+    test::write_bytes(box.path("b.bin"), four);
+    write_text(box.path("model/b.gltf"), gltf_triangle("", "..%2Fb.bin"));
+    r = step(box, with({"model/b.gltf"}, kStepSmall));
+    CHECK(r.code == 1);
+    CHECK(lines_of(r.err).size() == 1);
+    CHECK(has_line_with(r.err, "step: ", "buffer uri '../b.bin' refused: climbs out of the model's folder"));
+    CHECK(r.err.find("--allow-outside-paths") == std::string::npos);
+    CHECK(r.out.empty());
+
+    // The accessor budget.
+    write_text(box.path("model/huge.gltf"),
+               R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+               R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+               R"("accessors":[{"componentType":5126,"count":268435456,"type":"VEC3"}]})");
+    r = step(box, with({"model/huge.gltf"}, kStepSmall));
+    CHECK(r.code == 1);
+    CHECK(has_line_with(r.err, "step: ", "268435456 elements without a bufferView"));
+    CHECK(lines_of(r.err).size() == 1);
+
+    // A hostile PNG as a texture: one warning, the frame is still recorded.
+    const std::string rows(17, '\0');
+    test::write_bytes(box.path("model/huge.png"),
+                      bytes_of(kPngSignature + png_ihdr(16384, 16384, 8, 6) + png_chunk("IDAT", zlib_stored(rows)) +
+                               png_chunk("IEND", "")));
+    write_text(box.path("model/m.mtl"), "newmtl a\nmap_Kd huge.png\n");
+    r = step(box, with({"model/m.obj"}, kStepSmall));
+    CHECK(r.code == 0);
+    CHECK(has_line_with(r.err, "step: warning: ", "huge.png: cannot decode PNG image: 16384x16384 texels"));
+    CHECK(lines_of(r.err).size() == 1);
+
+    // step may serve what it reads to a browser: the way out stays shut.
+    r = step(box, with({"model/m.obj", "--allow-outside-paths"}, kStepSmall));
+    CHECK(r.code == 2);
+    CHECK(r.err == "step: --allow-outside-paths: not a step option (step reads only files inside the model's "
+                   "folder: it may show them in a web page)\n");
+}
+
+TEST_CASE("prast-diff on hostile and mismatched images: one line, exit 2, never a crash or a hang") {
+    CliSandbox box;
+    write_png(box.path("a.png"), 12, 8, 10, 20, 30);
+    // A JPEG whose Huffman table overflows stb_image 2.27's (read through the
+    // renderer's guard now, not by stb directly).
+    std::vector<unsigned char> jpg;
+    std::vector<unsigned char> px(16 * 16 * 3, 0);
+    for (std::size_t i = 0; i < px.size(); ++i) px[i] = (unsigned char)(i * 7);
+    stbi_write_jpg_to_func(
+        [](void* ctx, void* data, int size) {
+            auto* o = static_cast<std::vector<unsigned char>*>(ctx);
+            o->insert(o->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
+        },
+        &jpg, 16, 16, 3, px.data(), 90);
+    for (std::size_t i = 0; i + 1 < jpg.size(); ++i)
+        if (jpg[i] == 0xFF && jpg[i + 1] == 0xC4) {
+            jpg[i + 5 + 15] = 255;
+            break;
+        }
+    test::write_bytes(box.path("dht.jpg"), jpg);
+    const std::string rows(17, '\0');
+    test::write_bytes(box.path("huge.png"), bytes_of(kPngSignature + png_ihdr(16384, 16384, 8, 6) +
+                                                      png_chunk("IDAT", zlib_stored(rows)) + png_chunk("IEND", "")));
+    const std::string grey_rows = png_rows(16, 8, 8, false, [](int x, int) { return std::uint64_t(x); });
+    std::string cut = kPngSignature + png_ihdr(16, 8, 8, 0) + png_chunk("IDAT", zlib_stored(grey_rows));
+    test::write_bytes(box.path("cut.png"), bytes_of(cut.substr(0, cut.size() - 30)));
+    test::write_bytes(box.path("empty.png"), {});
+    REQUIRE(mkfifo(box.path("fifo.png").c_str(), 0600) == 0);
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"dht.jpg", "prast-diff: dht.jpg: cannot decode JPEG image: Huffman table"},
+        {"huge.png", "prast-diff: huge.png: cannot decode PNG image: 16384x16384 texels need at least 1073741824 bytes"},
+        {"cut.png", "prast-diff: cut.png: cannot decode PNG image: "},
+        {"empty.png", "prast-diff: empty.png: empty file"},
+        {"fifo.png", "prast-diff: fifo.png: not a regular file (a FIFO)"},
+        {"/dev/zero", "prast-diff: /dev/zero: not a regular file"},
+        {"/proc/self/status", "prast-diff: /proc/self/status: "},
+    };
+    for (const auto& [file, message] : cases) {
+        CAPTURE(file);
+        for (const bool first : {true, false}) {
+            const CliRun r = prast_diff(box, first ? std::vector<std::string>{file, "a.png"}
+                                                   : std::vector<std::string>{"a.png", file});
+            CHECK(r.code == 2);
+            CHECK(r.err.rfind(message, 0) == 0);
+            CHECK(lines_of(r.err).size() == 1);
+            CHECK(r.out.empty());
+        }
+    }
+    // Mismatched but readable: the same texels as grey, RGB, RGBA, 16-bit and
+    // Adam7 interlaced files all match; another size differs (exit 1).
+    const auto grey = [](int x, int y) { return std::uint64_t((x * 13 + y * 7) & 0xFF); };
+    const auto put = [&](const std::string& name, int depth, int colour, int interlace, int bits,
+                         const std::function<std::uint64_t(int, int)>& f) {
+        test::write_bytes(box.path(name), bytes_of(kPngSignature + png_ihdr(16, 8, depth, colour, interlace) +
+                                                   png_chunk("IDAT", zlib_stored(png_rows(16, 8, bits, interlace == 1, f))) +
+                                                   png_chunk("IEND", "")));
+    };
+    put("grey.png", 8, 0, 0, 8, grey);
+    put("rgb.png", 8, 2, 1, 24, [&](int x, int y) { return grey(x, y) * 0x010101u; });
+    put("rgba.png", 8, 6, 0, 32, [&](int x, int y) { return grey(x, y) * 0x01010100u + 0xFF; });
+    put("grey16.png", 16, 0, 0, 16, [&](int x, int y) { return grey(x, y) * 0x0101u; });
+    for (const char* other : {"rgb.png", "rgba.png", "grey16.png"}) {
+        CAPTURE(other);
+        const CliRun r = prast_diff(box, {"grey.png", other});
+        CHECK(r.code == 0);
+        CHECK(r.err.empty());
+    }
+    put("alpha.png", 8, 6, 0, 32, [&](int x, int y) { return grey(x, y) * 0x01010100u + (x == 3 && y == 2 ? 0x80 : 0xFF); });
+    const CliRun alpha = prast_diff(box, {"grey.png", "alpha.png"});
+    CHECK(alpha.code == 1);
+    CAPTURE(alpha.out);
+    CHECK(alpha.out.find("max difference: 127 at 3,2\n") != std::string::npos);
+    const CliRun sizes = prast_diff(box, {"grey.png", "a.png", "--heatmap", "h.png"});
+    CHECK(sizes.code == 1);
+    CHECK(sizes.err == "prast-diff: sizes differ: grey.png is 16x8, a.png is 12x8 (no heat map written)\n");
 }
 
 TEST_CASE("fuzz regressions: every input the fuzzers found is handled cleanly, in bounded time") {
