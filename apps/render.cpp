@@ -35,10 +35,13 @@
 #include "scene/camera.h"
 #include "scene/default_scene.h"
 #include "scene/image.h"
+#include "scene/load_environment.h"
 #include "scene/load_scene.h"
 #include "scene/messages.h"
 #include "scene/write_image.h"
+#include "shading/environment.h"
 #include "shading/scene_renderer.h"
+#include "shading/surface.h"
 #include "shading/tonemap.h"
 
 namespace fs = std::filesystem;
@@ -310,15 +313,26 @@ glm::vec3 rotate_around(const glm::vec3& v, const glm::vec3& k, double radians) 
 struct PixelHit {
     int mesh = -1;
     std::size_t triangle = 0;
+    float u = 0.0f, v = 0.0f;  // barycentrics of vertices 1 and 2
+    glm::vec3 origin{0.0f}, dir{0.0f};
 };
 
-PixelHit cast_pixel_ray(const Scene& scene, const Camera& cam, int width, int height, glm::ivec2 px) {
+// The ray through pixel centre (x, y): origin on the near plane, direction to the far plane.
+void pixel_ray(const Camera& cam, int width, int height, glm::vec2 px, glm::vec3& origin, glm::vec3& dir) {
     const glm::mat4 inv = glm::inverse(cam.view_projection(float(width) / float(height)));
-    const float x_ndc = (float(px.x) + 0.5f) / float(width) * 2.0f - 1.0f;
-    const float y_ndc = 1.0f - (float(px.y) + 0.5f) / float(height) * 2.0f;
+    const float x_ndc = (px.x + 0.5f) / float(width) * 2.0f - 1.0f;
+    const float y_ndc = 1.0f - (px.y + 0.5f) / float(height) * 2.0f;
     glm::vec4 a = inv * glm::vec4(x_ndc, y_ndc, -1.0f, 1.0f), b = inv * glm::vec4(x_ndc, y_ndc, 1.0f, 1.0f);
-    const glm::vec3 origin = glm::vec3(a) / a.w, dir = glm::vec3(b) / b.w - origin;
+    origin = glm::vec3(a) / a.w;
+    dir = glm::vec3(b) / b.w - origin;
+}
+
+PixelHit cast_pixel_ray(const Scene& scene, const Camera& cam, int width, int height, glm::ivec2 px) {
+    glm::vec3 origin, dir;
+    pixel_ray(cam, width, height, glm::vec2(px), origin, dir);
     PixelHit hit;
+    hit.origin = origin;
+    hit.dir = dir;
     float best = 1.0f;  // ray parameter: 0 at the near plane, 1 at the far plane
     for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
         const Mesh& mesh = scene.meshes[m];
@@ -344,14 +358,78 @@ PixelHit cast_pixel_ray(const Scene& scene, const Camera& cam, int width, int he
                 best = tr;
                 hit.mesh = int(m);
                 hit.triangle = t / 3;
+                hit.u = u;
+                hit.v = v;
             }
         }
     }
     return hit;
 }
 
+// The surface point a ray hit, interpolated from the triangle's vertices as
+// the rasterizer would (barycentrics of the hit); the uv derivatives from the
+// rays through the next pixel to the right and below, met on the triangle's plane.
+SurfacePoint surface_at_hit(const Mesh& mesh, const PixelHit& hit, const Camera& cam, int width, int height,
+                            glm::ivec2 px) {
+    const std::uint32_t i0 = mesh.indices[hit.triangle * 3], i1 = mesh.indices[hit.triangle * 3 + 1],
+                        i2 = mesh.indices[hit.triangle * 3 + 2];
+    auto lerp3 = [&](const auto& attr, float u, float v, auto fallback) {
+        using T = decltype(fallback);
+        if (attr.size() <= std::max({i0, i1, i2})) return fallback;
+        return T(attr[i0] * (1.0f - u - v) + attr[i1] * u + attr[i2] * v);
+    };
+    const glm::vec3 p0 = mesh.positions[i0], e1 = mesh.positions[i1] - p0, e2 = mesh.positions[i2] - p0;
+    // Barycentrics where another pixel's ray meets the triangle's plane.
+    auto plane_uv = [&](glm::vec2 at) {
+        glm::vec3 o, d;
+        pixel_ray(cam, width, height, at, o, d);
+        const glm::vec3 p = glm::cross(d, e2);
+        const float det = glm::dot(e1, p);
+        if (det == 0.0f) return glm::vec2(hit.u, hit.v);
+        const glm::vec3 s = o - p0, q = glm::cross(s, e1);
+        return glm::vec2(glm::dot(s, p) / det, glm::dot(d, q) / det);
+    };
+    SurfacePoint sp;
+    sp.P = lerp3(mesh.positions, hit.u, hit.v, glm::vec3(0.0f));
+    sp.N = lerp3(mesh.normals, hit.u, hit.v, glm::vec3(0.0f, 0.0f, 1.0f));
+    sp.T = lerp3(mesh.tangents, hit.u, hit.v, glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+    sp.uv = lerp3(mesh.uvs, hit.u, hit.v, glm::vec2(0.0f));
+    const glm::vec2 bx = plane_uv(glm::vec2(px) + glm::vec2(1.0f, 0.0f)), by = plane_uv(glm::vec2(px) + glm::vec2(0.0f, 1.0f));
+    sp.duv_dx = lerp3(mesh.uvs, bx.x, bx.y, glm::vec2(0.0f)) - sp.uv;
+    sp.duv_dy = lerp3(mesh.uvs, by.x, by.y, glm::vec2(0.0f)) - sp.uv;
+    sp.front_facing = glm::dot(glm::cross(e1, e2), hit.dir) < 0.0f;
+    return sp;
+}
+
+// The split sum's terms at the hit and the reference integral (--pixel with
+// an environment): what the stepper shows, and the number it approximates.
+void print_pixel_ibl(SceneRenderer& sr, const FrameSettings& settings, const Mesh& mesh, const PixelHit& hit,
+                     int width, int height, glm::ivec2 px, int samples) {
+    static const Material kFallback;
+    static const BoundMaterial kFallbackBound{&kFallback};
+    const BoundMaterial& bm = mesh.material >= 0 && std::size_t(mesh.material) < sr.materials().size()
+                                  ? sr.materials()[std::size_t(mesh.material)] : kFallbackBound;
+    const SurfacePoint sp = surface_at_hit(mesh, hit, settings.camera, width, height, px);
+    const MaterialSample ms = sample_material(bm, sp);
+    ShadingContext ctx = sr.shading_context(settings);
+    ctx.lights.clear();  // the environment's share alone
+    const IblTerms t = ibl_terms(ms, sp, ctx);
+    const glm::vec3 split = t.diffuse + t.specular;
+    const glm::vec3 ref = ibl_reference(ms, sp, ctx, samples);
+    std::printf("  ibl split-sum %.6g %.6g %.6g = diffuse %.6g %.6g %.6g + specular %.6g %.6g %.6g\n",
+                double(split.r), double(split.g), double(split.b), double(t.diffuse.r), double(t.diffuse.g),
+                double(t.diffuse.b), double(t.specular.r), double(t.specular.g), double(t.specular.b));
+    std::printf("  ibl terms: irradiance %.6g %.6g %.6g prefiltered %.6g %.6g %.6g level %.4f "
+                "dfg scale %.6g bias %.6g diffuse %.6g n.v %.4f occlusion %.4g\n",
+                double(t.irradiance.r), double(t.irradiance.g), double(t.irradiance.b), double(t.prefiltered.r),
+                double(t.prefiltered.g), double(t.prefiltered.b), double(t.level), double(t.dfg_scale),
+                double(t.dfg_bias), double(t.dfg_diffuse), double(t.NoV), double(t.occlusion));
+    std::printf("  ibl reference (%d samples) %.6g %.6g %.6g\n", samples, double(ref.r), double(ref.g),
+                double(ref.b));
+}
+
 void print_pixel(const Scene& scene, const Camera& cam, const Framebuffer& fb, const std::vector<std::uint8_t>& rgba8,
-                 glm::ivec2 px, int frame) {
+                 glm::ivec2 px, int frame, SceneRenderer& sr, const FrameSettings& settings, int ibl_samples) {
     const float* c = fb.pixel(px.x, px.y);
     const float depth = fb.depth[std::size_t(px.y) * std::size_t(fb.width) + std::size_t(px.x)];
     std::printf("pixel %d,%d frame %d: depth %.6f linear %.6g %.6g %.6g", px.x, px.y, frame, double(depth),
@@ -372,6 +450,7 @@ void print_pixel(const Scene& scene, const Camera& cam, const Framebuffer& fb, c
     const Mesh& mesh = scene.meshes[std::size_t(hit.mesh)];
     std::printf(" mesh %d '%s' triangle %zu material '%s'\n", hit.mesh, printable(mesh.name).c_str(), hit.triangle,
                 printable(scene.materials[std::size_t(std::max(0, mesh.material))].name).c_str());
+    if (sr.environment(settings)) print_pixel_ibl(sr, settings, mesh, hit, fb.width, fb.height, px, ibl_samples);
 }
 
 int run(int argc, char** argv) {
@@ -457,18 +536,36 @@ int run(int argc, char** argv) {
                         std::to_string(plan.image) + "), more than the " + std::to_string(budget) +
                         " bytes allowed (half the physical memory)");
 
-    // Lights: the scene's and the flags'; the default rig only when neither has any.
+    // The environment: --env, or the scene's own (the built-in sky).
+    std::shared_ptr<const Image> env_image = scene.environment;
+    if (!opt.env.empty()) {
+        try {
+            env_image = std::make_shared<const Image>(load_environment_hdr(opt.env));
+        } catch (const LoadError& e) {
+            return fail(kExitBadFile, e.what());
+        }
+    }
+
+    // Lights: the scene's and the flags'; the default rig only when neither has
+    // any and no environment lights the scene.
     FrameSettings settings;
     settings.lights = shading_lights(scene);
     settings.lights.insert(settings.lights.end(), opt.lights.begin(), opt.lights.end());
-    if (settings.lights.empty() && !opt.no_default_lights) {
+    if (settings.lights.empty() && !opt.no_default_lights && !env_image) {
         settings.lights = default_light_rig();
         progress.note("render: no lights in the scene or flags: using the default key+fill rig "
                       "(--no-default-lights to disable)");
     }
+    if (env_image && opt.ambient_given)
+        progress.note("render: warning: --ambient is not used: the environment map replaces the ambient term");
     settings.ambient = opt.ambient;
     settings.model = opt.brdf;
     settings.view = opt.view;
+    settings.ibl = opt.ibl;
+    settings.ibl_samples = opt.ibl_samples;
+    settings.energy = opt.energy;
+    settings.background = opt.background;
+    settings.background_color = opt.background_color;
     settings.samples = opt.msaa;
 
     progress.begin(1, "decoding textures");
@@ -486,12 +583,35 @@ int run(int argc, char** argv) {
     const double textures_ms = ms_since(t_tex);
     for (const std::string& w : cap_warnings(scene_renderer.warnings())) progress.note("render: warning: " + w);
 
-    if (opt.stats)
+    // Prefilter the environment once for all frames, on the renderer's threads.
+    auto t_env = Clock::now();
+    std::unique_ptr<Environment> environment;
+    if (env_image) {
+        progress.begin(1, "prefiltering the environment");
+        EnvironmentSettings es;
+        es.intensity = opt.env_intensity;
+        es.rotate_deg = opt.env_rotate_deg;
+        es.importance_sampling = opt.ibl == IblMode::Reference || opt.pixel.has_value();
+        environment = std::make_unique<Environment>(Environment::build(*env_image, es, renderer.pool()));
+    }
+    settings.environment = environment.get();
+    settings.scene_environment = false;
+    const double env_ms = ms_since(t_env);
+
+    if (opt.stats) {
         std::printf("scene                  %zu triangles, %zu meshes, %zu materials, %zu images\n"
                     "time load              %.3f ms\ntime textures          %.3f ms\nthreads                %d, "
                     "tile %d\n",
                     scene.triangle_count(), scene.meshes.size(), scene.materials.size(), scene.images.size(),
                     load_ms, textures_ms, renderer.threads(), renderer.tile_size());
+        if (environment) {
+            const EnvironmentTimings& et = environment->timings();
+            std::printf("environment            %dx%d\ntime environment       %.3f ms (mips %.3f, sh %.3f, "
+                        "prefilter %.3f, sampler %.3f)\n",
+                        environment->width(), environment->height(), env_ms, et.mips, et.sh, et.prefilter,
+                        et.sampler);
+        }
+    }
 
     Framebuffer fb(opt.width, opt.height);
     std::vector<std::uint8_t> rgba8(opt.hdr_output() ? 0 : std::size_t(opt.width) * opt.height * 4);
@@ -542,7 +662,9 @@ int run(int argc, char** argv) {
             std::printf("frame                  %d\n%stime frame+resolve     %.3f ms\ntime write             %.3f ms\n",
                         frame, renderer.stats().to_string().c_str(), render_ms, ms_since(t_write));
         }
-        if (opt.pixel) print_pixel(scene, cam, fb, rgba8, *opt.pixel, frame);
+        if (opt.pixel)
+            print_pixel(scene, cam, fb, rgba8, *opt.pixel, frame, scene_renderer, settings,
+                        opt.samples_given ? opt.ibl_samples : 4096);
         std::fflush(stdout);
     }
     progress.finish();

@@ -17,6 +17,7 @@
 #include <glm/glm.hpp>
 
 #include "raster/limits.h"
+#include "shading/background.h"
 #include "shading/brdf.h"
 #include "shading/debug_view.h"
 #include "shading/surface.h"
@@ -46,6 +47,8 @@ constexpr double kMaxCameraCoordinate = 1e18;
 constexpr double kMinFovDeg = 0.001;
 constexpr long kMaxFrames = 1000000;
 constexpr long kMaxRepeat = 100000;
+constexpr long kMaxIblSamples = 1 << 20;
+constexpr double kMaxEnvIntensity = 1e6;
 
 // Samples per pixel unless --msaa says otherwise: README "Anti-aliasing"
 // gives the measurements behind it.
@@ -60,7 +63,18 @@ struct RenderOptions {
     std::optional<float> near_plane, far_plane;  // unset: fit_clip_planes
     std::vector<ShadingLight> lights;  // --sun and --point, in command-line order
     glm::vec3 ambient{0.03f};
+    bool ambient_given = false;
     bool no_default_lights = false;
+    // Image-based lighting (the built-in scene has a sky of its own).
+    std::string env;                   // --env FILE.hdr
+    float env_intensity = 1.0f;
+    float env_rotate_deg = 0.0f;
+    Background background = Background::Env;  // black when there is no environment
+    glm::vec3 background_color{0.0f};
+    IblMode ibl = IblMode::SplitSum;
+    int ibl_samples = 256;             // --samples, for --ibl reference and --pixel
+    bool samples_given = false;
+    bool energy = false;               // --energy conserve
     BrdfModel brdf = BrdfModel::Default;
     float exposure = 1.0f;
     // Default aces (highlights roll off instead of clipping, so `render
@@ -102,12 +116,12 @@ inline const char* render_usage() {
 "  --point X,Y,Z:R,G,B  point light, radiance R,G,B / distance^2 (repeatable)\n"
 "  --ambient R,G,B      ambient light (default 0.03,0.03,0.03)\n"
 "  --no-default-lights  no key+fill rig when the scene and flags have no light\n"
-"  --env FILE.hdr       image-based lighting: NOT IMPLEMENTED YET (exit 2)\n"
-"  --brdf default|gltf  the conventions' Cook-Torrance (default) or glTF's\n"
+"  --env FILE.hdr --env-intensity E --env-rotate DEG   image-based lighting\n"
+"  --background env|blur|black|R,G,B  --ibl split-sum|reference --samples N\n"
+"  --brdf default|gltf --energy off|conserve --msaa N (1, 2, 4, 8; default 4)\n"
 "  --exposure E --tonemap none|aces|neutral   default 1, aces (none with --view)\n"
 "  --view NAME          albedo normal roughness metallic uv depth overdraw tiles\n"
-"                       ndf fresnel geometry diffuse specular\n"
-"  --msaa N             samples per pixel: 1, 2, 4 or 8 (default 4)\n"
+"                       ndf fresnel geometry diffuse specular irradiance\n"
 "  --threads N          default: all cores      --tile N  16..256 (default 64)\n"
 "  --frames N --orbit DEG  turntable: N images orbiting the target around --up,\n"
 "    DEG in total (default 360); FILE needs %04d; --frame-range A-B: frames A..B\n"
@@ -263,6 +277,7 @@ inline std::string parse_render_args(int argc, const char* const* argv, RenderOp
     using namespace render_cli;
     bool frames_given = false, only_positional = false;
     std::string range_text;
+    std::string needs_env;  // the first flag given that needs an environment, with its value
     for (int i = 1; i < argc; ++i) {
         std::string arg = argv[i];
         if (only_positional || arg.empty() || arg[0] != '-' || arg == "-") {
@@ -369,12 +384,59 @@ inline std::string parse_render_args(int argc, const char* const* argv, RenderOp
             if (!parse_vec3(v, rgb)) return bad(v, "expected three finite numbers R,G,B");
             if (!non_negative(rgb)) return bad(v, "must not be negative");
             out.ambient = rgb;
+            out.ambient_given = true;
         } else if (flag == "--no-default-lights") {
             if (!(err = no_value()).empty()) return err;
             out.no_default_lights = true;
         } else if (flag == "--env") {
             if (!(err = value("FILE.hdr", v)).empty()) return err;
-            return "--env: image-based lighting is not implemented yet";
+            if (v.empty()) return flag + ": empty file name";
+            if (!ends_with(lower(v), ".hdr")) return bad(v, "expected an equirectangular Radiance .hdr file");
+            out.env = v;
+        } else if (flag == "--env-intensity") {
+            if (!(err = value("E", v)).empty()) return err;
+            double d;
+            if (!parse_finite(v, d)) return bad(v, "not a finite number");
+            if (d < 0.0 || d > kMaxEnvIntensity) return bad(v, "must be between 0 and 1e6");
+            out.env_intensity = float(d);
+            if (needs_env.empty()) needs_env = flag + " '" + v + "'";
+        } else if (flag == "--env-rotate") {
+            if (!(err = value("DEG", v)).empty()) return err;
+            double d;
+            if (!parse_finite(v, d) || std::fabs(d) > 1e6) return bad(v, "not a finite number of degrees");
+            out.env_rotate_deg = float(std::fmod(d, 360.0));
+            if (needs_env.empty()) needs_env = flag + " '" + v + "'";
+        } else if (flag == "--background") {
+            if (!(err = value("env|blur|black|R,G,B", v)).empty()) return err;
+            glm::vec3 rgb;
+            if ((v == "env" || v == "blur") && needs_env.empty()) needs_env = flag + " " + v;
+            if (v == "env") out.background = Background::Env;
+            else if (v == "blur") out.background = Background::Blur;
+            else if (v == "black") out.background = Background::Black;
+            else if (parse_vec3(v, rgb) && non_negative(rgb)) {
+                out.background = Background::Color;
+                out.background_color = rgb;
+            } else {
+                return bad(v, "expected env, blur, black or R,G,B (finite, not negative)");
+            }
+        } else if (flag == "--ibl") {
+            if (!(err = value("split-sum|reference", v)).empty()) return err;
+            if (v == "split-sum") out.ibl = IblMode::SplitSum;
+            else if (v == "reference") out.ibl = IblMode::Reference;
+            else return bad(v, "expected split-sum or reference");
+            if (needs_env.empty()) needs_env = flag + " " + v;
+        } else if (flag == "--samples") {
+            if (!(err = value("N", v)).empty()) return err;
+            long n;
+            if (!parse_integer(v, n)) return bad(v, "not an integer");
+            if (n < 1 || n > kMaxIblSamples) return bad(v, "must be between 1 and " + std::to_string(kMaxIblSamples));
+            out.ibl_samples = int(n);
+            out.samples_given = true;
+        } else if (flag == "--energy") {
+            if (!(err = value("off|conserve", v)).empty()) return err;
+            if (v == "off") out.energy = false;
+            else if (v == "conserve") out.energy = true;
+            else return bad(v, "expected off or conserve");
         } else if (flag == "--brdf") {
             if (!(err = value("default|gltf", v)).empty()) return err;
             if (!parse_brdf_model(v, out.brdf)) return bad(v, "expected default or gltf");
@@ -463,6 +525,11 @@ inline std::string parse_render_args(int argc, const char* const* argv, RenderOp
     if (out.near_plane && out.far_plane && !(*out.near_plane < *out.far_plane))
         return "--near/--far: near (" + std::to_string(*out.near_plane) + ") must be less than far (" +
                std::to_string(*out.far_plane) + ")";
+    // Environment flags need an environment: --env, or the built-in scene's sky.
+    if (!needs_env.empty() && out.env.empty() && !out.scene.empty())
+        return needs_env + ": needs --env FILE.hdr (the scene has no environment)";
+    if (out.samples_given && out.ibl != IblMode::Reference && !out.pixel)
+        return "--samples: only used with --ibl reference (or --pixel)";
     if (out.orbit_given && !frames_given) return "--orbit: needs --frames N (the number of turntable images)";
     render_cli::FramePattern pattern(out.output);
     if (out.frames > 1 && !pattern.has_number)

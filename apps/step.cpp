@@ -128,6 +128,10 @@ int run(int argc, char** argv) {
         std::printf("step (prast) %s\n", kRenderVersion);
         return 0;
     }
+    if (opt.ibl == IblMode::Reference) {
+        std::fprintf(stderr, "step: --ibl reference: step explains the split sum (render --pixel prints the reference)\n");
+        return kExitUsage;
+    }
     if (opt.pixel && (so.serve || !so.out_dir.empty())) {
         std::fprintf(stderr, "step: --pixel: not with --out or --serve\n");
         return kExitUsage;
@@ -147,6 +151,12 @@ int run(int argc, char** argv) {
     req.ambient = opt.ambient;
     req.no_default_lights = opt.no_default_lights;
     req.brdf = opt.brdf;
+    req.env = opt.env;
+    req.env_intensity = opt.env_intensity;
+    req.env_rotate_deg = opt.env_rotate_deg;
+    req.background = opt.background;
+    req.background_color = opt.background_color;
+    req.energy = opt.energy;
     req.exposure = opt.exposure;
     req.tonemap = opt.effective_tonemap();
     req.threads = opt.threads;

@@ -15,21 +15,33 @@
 #include "stepper/scene_setup.h"
 #include "stepper/session.h"
 
+namespace {
+
+using namespace prast::stepper;
+
+StepScene g_scene;
+Recording g_rec;
+Session* g_session = nullptr;
+
+} // namespace
+
+// The recording is made before fuzzing starts, outside the per-input timeout
+// (the built-in scene's procedural textures take seconds in this build).
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+    if (chdir(prast::fuzz::make_model_dir("step").c_str()) != 0) __builtin_trap();
+    FrameRequest req;
+    req.width = 48;
+    req.height = 32;
+    req.threads = 1;
+    SetupError err;
+    if (!setup_scene(req, g_scene, err)) __builtin_trap();
+    record_frame(g_scene, g_rec);
+    g_session = new Session(g_scene, g_rec);
+    return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    using namespace prast::stepper;
-    static StepScene scene;
-    static Recording rec;
-    static Session* session = [] {
-        if (chdir(prast::fuzz::make_model_dir("step").c_str()) != 0) __builtin_trap();
-        FrameRequest req;
-        req.width = 48;
-        req.height = 32;
-        req.threads = 1;
-        SetupError err;
-        if (!setup_scene(req, scene, err)) __builtin_trap();
-        record_frame(scene, rec);
-        return new Session(scene, rec);
-    }();
+    Session* session = g_session;
     const std::string text(reinterpret_cast<const char*>(data), size);
     std::size_t begin = 0;
     for (int n = 0; n < 16 && begin <= text.size(); ++n) {

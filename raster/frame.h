@@ -15,6 +15,7 @@
 // inside stays inlined.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <type_traits>
 #include <utility>
@@ -35,6 +36,14 @@ struct FrameOptions {
     bool clear = true;      // clear colour and depth in the tile pass; false: draw over the target
     float clear_color[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     float clear_depth = 1.0f;
+    // Optional: a colour per pixel to clear to instead of clear_color (a
+    // background image): clear_fill(clear_user, x0, y0, width, height, rgba,
+    // row) writes pixel (x0 + i, y0 + j)'s RGBA at rgba[j * row + 4 i]; every
+    // sample of a pixel clears to it, so uncovered samples resolve to it.
+    using ClearFill = void (*)(const void* user, int x0, int y0, int width, int height, float* rgba,
+                               std::size_t row);
+    ClearFill clear_fill = nullptr;
+    const void* clear_user = nullptr;
     // Shade each sample's winner once (the visibility pass): in every tile
     // (Always), never (every draw shaded in submission order, as draw calls
     // used to), or in the tiles whose triangles cover more than

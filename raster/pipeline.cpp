@@ -3,6 +3,7 @@
 #include "raster/pipeline.h"
 
 #include <algorithm>
+#include <cstring>
 #include <numeric>
 
 #if defined(__AVX2__)
@@ -227,6 +228,23 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     if (options_.clear) {
         if (S == 1) clear_tile(fb, r, options_.clear_color, options_.clear_depth);
         else clear_samples(tg.color, tg.depth, T, S, options_.clear_color, options_.clear_depth);
+        if (options_.clear_fill && tg.color) {
+            if (S == 1) {
+                options_.clear_fill(options_.clear_user, r.x0, r.y0, r.width(), r.height(),
+                                    &fb.color[(std::size_t(r.y0) * std::size_t(fb.width) + std::size_t(r.x0)) * 4],
+                                    std::size_t(fb.width) * 4);
+            } else {
+                // Plane 0, then the same pixels into every other sample's plane.
+                const std::size_t plane = std::size_t(T) * std::size_t(T) * 4;
+                options_.clear_fill(options_.clear_user, r.x0, r.y0, r.width(), r.height(), tg.color,
+                                    std::size_t(T) * 4);
+                for (int s = 1; s < S; ++s)
+                    for (int y = 0; y < r.height(); ++y)
+                        std::memcpy(tg.color + s * plane + std::size_t(y) * std::size_t(T) * 4,
+                                    tg.color + std::size_t(y) * std::size_t(T) * 4,
+                                    std::size_t(r.width()) * 4 * sizeof(float));
+            }
+        }
     } else if (S > 1) {
         load_samples(fb, r, tg.color, tg.depth, T, S);
     }

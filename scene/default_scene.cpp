@@ -1,6 +1,8 @@
 // The built-in scene; see default_scene.h.
 #include "scene/default_scene.h"
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "scene/mesh_gen.h"
@@ -14,7 +16,44 @@ constexpr int kRows = 4;     // metallic 0 .. 1 (bottom to top)
 constexpr float kSpacing = 1.0f;
 constexpr float kRadius = 0.4f;
 constexpr int kTextureSize = 512;
+constexpr int kSkyWidth = 512;
+// Towards the sun: the sun light's direction and the sky's sun disc.
+const glm::vec3 kSunDirection = glm::normalize(glm::vec3(-0.4f, 0.7f, 0.6f));
+
+float smoothstep(float e0, float e1, float x) {
+    const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
+    return t * t * (3.0f - 2.0f * t);
+}
 } // namespace
+
+Image make_default_sky(int width) {
+    Image img;
+    img.width = width;
+    img.height = std::max(1, width / 2);
+    img.rgba.assign(std::size_t(img.width) * std::size_t(img.height) * 4, 0.0f);
+    const glm::vec3 zenith(0.06f, 0.12f, 0.32f), horizon(0.32f, 0.36f, 0.42f);
+    const glm::vec3 ground(0.07f, 0.06f, 0.05f), sun(60.0f, 55.0f, 48.0f);
+    const float sun_radius = 0.03f;  // radians, about 1.7 degrees
+    const float texel = 3.14159265f / float(img.height);
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            // The direction of the texel centre (conventions.md "Environment maps").
+            const float phi = ((float(x) + 0.5f) / float(img.width) - 0.5f) * 6.28318531f;
+            const float theta = (float(y) + 0.5f) / float(img.height) * 3.14159265f;
+            const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+            const float up = std::max(d.y, 0.0f);
+            glm::vec3 sky = glm::mix(horizon, zenith, std::sqrt(up));
+            // The ground darkens towards the nadir; one texel of blend at the horizon.
+            const glm::vec3 below = ground * (0.6f + 0.4f * (1.0f + d.y));
+            glm::vec3 c = glm::mix(below, sky, smoothstep(-texel, texel, d.y));
+            // Sun disc with an anti-aliased rim and a faint glow.
+            const float angle = std::acos(std::clamp(glm::dot(d, kSunDirection), -1.0f, 1.0f));
+            c += sun * (1.0f - smoothstep(sun_radius - texel, sun_radius + texel, angle));
+            c += glm::vec3(1.0f, 0.9f, 0.7f) * (0.6f * std::exp(-angle / 0.12f));
+            img.set(x, y, glm::vec4(c, 1.0f));
+        }
+    return img;
+}
 
 DefaultScene make_default_scene() {
     DefaultScene d;
@@ -59,7 +98,7 @@ DefaultScene make_default_scene() {
 
     Light sun;
     sun.type = Light::Type::Directional;
-    sun.direction = glm::normalize(glm::vec3(-0.4f, 0.7f, 0.6f));
+    sun.direction = kSunDirection;
     sun.color = glm::vec3(1.0f, 0.96f, 0.9f);
     sun.intensity = 3.0f;
     Light lamp;
@@ -68,6 +107,7 @@ DefaultScene make_default_scene() {
     lamp.color = glm::vec3(0.6f, 0.75f, 1.0f);
     lamp.intensity = 12.0f;
     s.lights = {sun, lamp};
+    s.environment = std::make_shared<const Image>(make_default_sky(kSkyWidth));
 
     d.camera.eye = glm::vec3(0.0f, 3.2f, 7.6f);
     d.camera.target = glm::vec3(0.0f, 1.9f, 0.0f);

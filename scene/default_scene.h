@@ -1,11 +1,13 @@
 // The built-in scene `render` draws with no arguments: a grid of spheres that
 // sweeps roughness (columns, 0 to 1) against metallic (rows, 0 to 1), standing
 // on a floor of tiles whose albedo, normal and roughness/metal maps are made by
-// code here (procedural_images.h), lit by a sun and a point light. No
+// code here (procedural_images.h), lit by a sun and a point light and by a
+// procedural sky (make_default_sky) that the metal spheres reflect. No
 // third-party file is involved.
 #pragma once
 
 #include "scene/camera.h"
+#include "scene/image.h"
 #include "scene/scene.h"
 
 namespace prast {
@@ -16,5 +18,10 @@ struct DefaultScene {
 };
 
 DefaultScene make_default_scene();
+
+// The built-in scene's environment, an equirect map of `width` x width/2
+// texels (linear radiance): a sky from a pale horizon to a blue zenith, a
+// small sun disc where the scene's sun light comes from, and a dim ground.
+Image make_default_sky(int width);
 
 } // namespace prast

@@ -397,8 +397,8 @@ constexpr std::int64_t kMaxJpegTexelsPerByte = 1024;
 // length and a distance code), so 1032 bytes per compressed byte.
 constexpr std::int64_t kMaxDeflateRatio = 1032;
 
-// "" when a PNG's IDAT chunks can hold the pixels its header claims; else
-// why not. Checked before any decoder allocates the image: a 100-byte file
+// "" when every chunk of a PNG lies within the file and its IDAT chunks can
+// hold the pixels its header claims; else why not. Checked before any decoder allocates the image: a 100-byte file
 // claiming 16384x16384 texels would otherwise cost a gigabyte of zeroed
 // memory before failing as truncated. The filtered rows hold at least
 // w * h * bits / 8 bytes (interlaced or not), and no more than
@@ -414,11 +414,14 @@ std::string png_data_shortfall(const unsigned char* data, std::size_t size, int 
     std::int64_t idat = 0;
     for (std::size_t pos = 8; pos + 12 <= size;) {
         const std::uint32_t len = be32(data + pos);
-        if (len > size - pos - 12) {  // the last chunk cut short: count what is there
-            if (std::memcmp(data + pos + 4, "IDAT", 4) == 0) idat += std::int64_t(size - pos - 8);
-            break;
-        }
-        if (std::memcmp(data + pos + 4, "IDAT", 4) == 0) idat += len;
+        const std::string type = printable(std::string(reinterpret_cast<const char*>(data + pos + 4), 4));
+        // A chunk past the end of the file: stb_image 2.27 grows its buffer
+        // to the claimed length first (up to 4 GiB for one 16-bit file).
+        if (len > size - pos - 12)
+            return "truncated: the " + type + " chunk at byte " + std::to_string(pos) + " claims " +
+                   std::to_string(len) + " bytes, " + std::to_string(size - pos - 12) + " are left";
+        if (type == "IDAT") idat += len;
+        if (type == "IEND") break;
         pos += 12 + std::size_t(len);
     }
     if (need <= kMaxDeflateRatio * idat + 1024) return "";

@@ -107,6 +107,9 @@ struct Scene {
     std::vector<Material> materials;     // never empty after loading
     std::vector<ImageSource> images;
     std::vector<Light> lights;           // from the file (KHR_lights_punctual)
+    // An equirect environment (linear radiance) that comes with the scene:
+    // the built-in scene's sky; null = none. `render --env` overrides it.
+    std::shared_ptr<const Image> environment;
     std::vector<std::string> warnings;   // one line each: "FILE: what was ignored/fallen back"
 
     Bounds bounds() const {

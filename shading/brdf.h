@@ -185,7 +185,25 @@ struct BrdfInputs {
     float roughness = 0.5f;  // perceptual; clamped to [0.045, 1] inside
     float ior = 1.5f;
     Conductor conductor = Conductor::None;  // not None: measured metal, albedo and metallic ignored
+    // Smith G with k = r^2 / 2, the conventions' k for image-based lighting
+    // (the reference integrator); analytic lights use (r + 1)^2 / 8.
+    bool ibl_geometry = false;
+    // --energy conserve (dfg.h): the specular lobe times energy_comp (multiple
+    // scattering), and kd = energy_kd = (1 - E_spec(v))(1 - metallic) instead
+    // of (1 - F)(1 - metallic).
+    bool energy = false;
+    glm::vec3 energy_comp{1.0f}, energy_kd{0.0f};
 };
+
+// F0 of the inputs: the conductor's reflectance at normal incidence, or the
+// conventions' mix of the dielectric's and the albedo by metallic.
+inline glm::vec3 brdf_f0(const BrdfInputs& in) {
+    if (in.conductor != Conductor::None) {
+        ConductorIOR ior = conductor_ior(in.conductor);
+        return F_ConductorSchlick(ior.eta, ior.k, 1.0f);
+    }
+    return glm::mix(glm::vec3(f0_from_ior(in.ior)), in.albedo, in.metallic);
+}
 
 // Every intermediate, for the debug stepper. The cosines are clamped to [0, 1].
 struct BrdfTerms {
@@ -229,13 +247,14 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
         t.G = V_SmithGGXCorrelated(t.NoV, t.NoL, alpha);
         t.specular = t.F * t.D * t.G;
     } else {
-        t.G = G_Smith(t.NoV, t.NoL, k_direct(r));
+        t.G = G_Smith(t.NoV, t.NoL, in.ibl_geometry ? k_ibl(r) : k_direct(r));
         t.specular = t.D * t.G * t.F /
                      (4.0f * std::max(t.NoV, kBrdfMinCos) * std::max(t.NoL, kBrdfMinCos));
     }
+    if (in.energy) t.specular = t.specular * in.energy_comp;
 
     // Evaluate the diffuse lobe: what the specular reflection leaves, if not a metal.
-    t.kd = (glm::vec3(1.0f) - t.F) * (1.0f - metallic);
+    t.kd = in.energy ? in.energy_kd : (glm::vec3(1.0f) - t.F) * (1.0f - metallic);
     t.diffuse = t.kd * in.albedo * Fd_Lambert();
     t.f = t.diffuse + t.specular;
     return t;

@@ -13,6 +13,7 @@ const Named kViews[] = {
     {"tiles", DebugView::Tiles},       {"ndf", DebugView::Ndf},
     {"fresnel", DebugView::Fresnel},   {"geometry", DebugView::Geometry},
     {"diffuse", DebugView::Diffuse},   {"specular", DebugView::Specular},
+    {"irradiance", DebugView::Irradiance},
 };
 } // namespace
 
@@ -34,7 +35,7 @@ bool debug_view_is_data(DebugView v) {
 
 const char* debug_view_names() {
     return "albedo, normal, roughness, metallic, uv, depth, overdraw, tiles, ndf, fresnel, "
-           "geometry, diffuse, specular";
+           "geometry, diffuse, specular, irradiance";
 }
 
 } // namespace prast

@@ -9,6 +9,7 @@ namespace prast {
 enum class DebugView {
     None, Albedo, Normal, Roughness, Metallic, Uv, Depth, Overdraw, Tiles,
     Ndf, Fresnel, Geometry, Diffuse, Specular,
+    Irradiance,  // E(n) / pi of the environment (what a white Lambertian surface reflects)
 };
 
 bool parse_debug_view(const std::string& name, DebugView& out);

@@ -28,6 +28,12 @@ glm::vec3 sum_lobes(const MaterialSample& ms, const SurfacePoint& sp, const Shad
         BrdfTerms t = evaluate_brdf(bi, ctx.model);
         sum += (specular ? t.specular : t.diffuse) * radiance * t.NoL;
     }
+    // The split sum's lobe of the environment (not in reference mode: the
+    // integral does not split into lobes).
+    if (ctx.env && ctx.ibl == IblMode::SplitSum) {
+        const IblTerms t = ibl_terms(ms, sp, ctx);
+        sum += specular ? t.specular : t.diffuse;
+    }
     return sum;
 }
 
@@ -123,8 +129,10 @@ void PbrProgram::shade_lanes(const FragmentBlock<kVaryings>& in, FragmentOut& ou
 void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
     const Material& m = *material->m;
     // The lit path samples the material and lights the lanes together, packed
-    // when few are live; debug views and conductor materials go lane by lane.
-    if ((view == DebugView::None || view == DebugView::Tiles) && m.conductor == Conductor::None) {
+    // when few are live; debug views, conductor materials and the reference
+    // integral of the environment go lane by lane.
+    const bool reference = ctx->env && ctx->ibl == IblMode::Reference;
+    if ((view == DebugView::None || view == DebugView::Tiles) && m.conductor == Conductor::None && !reference) {
         const int live = __builtin_popcount(in.mask);
         if (live > 8) shade_lanes<16>(in, out);
         else if (live > 4) shade_lanes<8>(in, out);
@@ -171,6 +179,7 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
         case DebugView::Geometry: c = glm::vec3(first_light_terms(ms, sp, *ctx).G); break;
         case DebugView::Diffuse: c = sum_lobes(ms, sp, *ctx, false); break;
         case DebugView::Specular: c = sum_lobes(ms, sp, *ctx, true); break;
+        case DebugView::Irradiance: c = ctx->env ? ctx->env->irradiance(ms.N) : glm::vec3(0.0f); break;
         }
         out.r[l] = c.r; out.g[l] = c.g; out.b[l] = c.b;
     }

@@ -6,6 +6,7 @@
 #include <mutex>
 #include <new>
 
+#include "scene/image.h"
 #include "shading/resolve.h"
 
 namespace prast {
@@ -160,17 +161,56 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
     }
 }
 
-void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out) {
-    renderer_.begin_frame();
-    FrameOptions frame;  // cleared to black, alpha 1, depth 1, in the tile pass
-    frame.samples = s.samples;
-    frame.visibility = s.visibility;
-    renderer_.begin(fb, frame);
+const Environment* SceneRenderer::environment(const FrameSettings& s) {
+    if (s.environment) return s.environment;
+    if (!s.scene_environment || !scene_.environment) return nullptr;
+    if (!scene_env_)
+        scene_env_ = std::make_unique<Environment>(
+            Environment::build(*scene_.environment, EnvironmentSettings{}, renderer_.pool()));
+    return scene_env_.get();
+}
+
+const DfgTable& SceneRenderer::dfg_table(DfgModel model) {
+    std::unique_ptr<DfgTable>& t = dfg_[int(model)];
+    if (!t) t = std::make_unique<DfgTable>(DfgTable::build(model, renderer_.pool()));
+    return *t;
+}
+
+ShadingContext SceneRenderer::shading_context(const FrameSettings& s) {
     ShadingContext ctx;
     ctx.eye = s.camera.eye;
     ctx.lights = s.lights;
     ctx.ambient = s.ambient;
     ctx.model = s.model;
+    const bool gltf = s.model == BrdfModel::Gltf;
+    ctx.env = environment(s);
+    if (ctx.env) {
+        ctx.dfg_ibl = &dfg_table(gltf ? DfgModel::HeightCorrelated : DfgModel::SchlickIbl);
+        ctx.ibl = s.ibl;
+        ctx.ibl_samples = s.ibl_samples;
+    }
+    ctx.energy = s.energy;
+    if (s.energy) ctx.dfg_light = &dfg_table(gltf ? DfgModel::HeightCorrelated : DfgModel::SchlickDirect);
+    return ctx;
+}
+
+BackgroundFill frame_background(const FrameSettings& s, const Environment* env, int width, int height) {
+    const bool lit = s.view == DebugView::None || s.view == DebugView::Tiles;
+    return BackgroundFill(s.camera, width, height, env, lit ? s.background : Background::Black, s.background_color);
+}
+
+void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out) {
+    const ShadingContext ctx = shading_context(s);
+    renderer_.begin_frame();
+    // Cleared in the tile pass: alpha 1, depth 1, and the background's colour
+    // (black unless an environment or a colour is shown), so that samples no
+    // triangle covers resolve to the background.
+    FrameOptions frame;
+    frame.samples = s.samples;
+    frame.visibility = s.visibility;
+    const BackgroundFill background = frame_background(s, ctx.env, fb.width, fb.height);
+    background.attach(frame);
+    renderer_.begin(fb, frame);
     const float aspect = float(fb.width) / float(fb.height);
     const glm::mat4 vp = s.camera.view_projection(aspect);
     static const Material kFallback;

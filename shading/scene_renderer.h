@@ -9,7 +9,10 @@
 
 #include "raster/pipeline.h"
 #include "scene/camera.h"
+#include "shading/background.h"
 #include "shading/debug_view.h"
+#include "shading/dfg.h"
+#include "shading/environment.h"
 #include "shading/pbr_program.h"
 #include "scene/scene.h"
 #include "shading/surface.h"
@@ -24,6 +27,17 @@ struct FrameSettings {
     glm::vec3 ambient{0.03f};
     BrdfModel model = BrdfModel::Default;
     DebugView view = DebugView::None;
+    // Image-based lighting: this environment, or when null the scene's own
+    // (Scene::environment, prefiltered on first use) unless scene_environment
+    // is false. With one, it replaces the ambient term.
+    const Environment* environment = nullptr;
+    bool scene_environment = true;
+    IblMode ibl = IblMode::SplitSum;
+    int ibl_samples = 256;
+    bool energy = false;   // --energy conserve
+    // Env and Blur need an environment (without one they draw black).
+    Background background = Background::Env;
+    glm::vec3 background_color{0.0f};
     int samples = 1;  // per pixel: 1, 2, 4 or 8 (README "Anti-aliasing")
     // Where the visibility pass runs (the bytes are the same either way).
     FrameOptions::Visibility visibility = FrameOptions::Visibility::Auto;
@@ -51,10 +65,18 @@ public:
     // decoded is dropped with a warning (the factor alone is used).
     SceneRenderer(const Scene& scene, Renderer& renderer);
 
-    // Renders one frame into fb (resized by the caller): clears to black,
-    // draws every mesh, and applies the overdraw/tiles debug overlays. With
-    // `out`, also writes the 8-bit image (in the tile pass, on every thread).
+    // Renders one frame into fb (resized by the caller): clears to the
+    // background (frame_background), draws every mesh, and applies the
+    // overdraw/tiles debug overlays. With `out`, also writes the 8-bit image
+    // (in the tile pass, on every thread).
     void render(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out = nullptr);
+
+    // The environment a frame with these settings is lit by (null: none).
+    const Environment* environment(const FrameSettings& settings);
+    // A DFG table, built on the renderer's pool on first use.
+    const DfgTable& dfg_table(DfgModel model);
+    // The context render() shades with (lights, eye, environment, tables).
+    ShadingContext shading_context(const FrameSettings& settings);
 
     const std::vector<std::string>& warnings() const { return warnings_; }
     const std::vector<BoundMaterial>& materials() const { return bound_; }
@@ -68,7 +90,13 @@ private:
     std::vector<std::unique_ptr<Texture>> packed_;    // OBJ roughness + metal pairs
     std::vector<BoundMaterial> bound_;
     std::vector<std::string> warnings_;
+    std::unique_ptr<Environment> scene_env_;   // from Scene::environment, on first use
+    std::unique_ptr<DfgTable> dfg_[3];         // by DfgModel, on first use
 };
+
+// The background a frame with these settings clears to: settings.background
+// for the lit image and the tiles view, black for the other debug views.
+BackgroundFill frame_background(const FrameSettings& settings, const Environment* env, int width, int height);
 
 // Debug-view post passes, exposed for tests.
 void apply_overdraw_heat(Framebuffer& fb);

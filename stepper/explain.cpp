@@ -464,19 +464,20 @@ PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, 
     px.y = y;
     px.samples = rec.samples;
     const int S = rec.samples;
-    const ShadingContext ctx = shading_context(s.settings);
+    const ShadingContext ctx = shading_context(s);
     const TileRecord& tile = rec.tiles[std::size_t(rec.tile_of(x, y))];
     const int bx = x & ~(kBlockSize - 1), by = y & ~(kBlockSize - 1);
     for (int l = 0; l < kBlockLanes; ++l)
         if (lane_x(l) == x - bx && lane_y(l) == y - by) px.lane = l;
     const int lane = px.lane;
-    // The tile pass, sample by sample: cleared, then each fragment in the
-    // tile's order. A draw taking the visibility pass writes depth and makes
-    // the fragment the sample's winner (`pending`), shaded once later; a draw
-    // shaded in order writes its colour at once.
+    // The tile pass, sample by sample: cleared (to the background), then each
+    // fragment in the tile's order. A draw taking the visibility pass writes
+    // depth and makes the fragment the sample's winner (`pending`), shaded
+    // once later; a draw shaded in order writes its colour at once.
+    px.background = frame_background(s, rec.fb.width, rec.fb.height).at(x, y);
     for (int i = 0; i < S; ++i) {
         px.sample_depth[i] = 1.0f;
-        px.sample_color[i] = glm::vec3(0.0f);
+        px.sample_color[i] = px.background;
         px.sample_owner[i] = -1;
     }
     int pending[kMaxSamples];
@@ -607,8 +608,19 @@ void shading_text(std::ostringstream& o, const StepScene& s, const Recording& re
         o << "    contribution (diffuse + specular) * radiance * n.l = " << vec(L.contribution) << "\n";
     }
     o << "  emissive " << vec(ms.emissive) << "\n";
-    o << "  ambient " << vec(s.settings.ambient) << " * albedo * occlusion = " << vec(sh.ambient) << "\n";
-    o << "  shaded colour (emissive + contributions + ambient) " << vec(sh.Lo) << "\n";
+    if (sh.ibl) {
+        const IblTerms& t = sh.ibl_terms;
+        o << "  environment (split sum): irradiance E(n)/pi " << vec(t.irradiance) << ", kd " << vec(t.kd)
+          << " -> diffuse " << vec(t.diffuse) << "\n";
+        o << "    prefiltered " << vec(t.prefiltered) << " along " << vec(t.R) << " at level " << num(t.level)
+          << ", dfg scale " << num(t.dfg_scale) << " bias " << num(t.dfg_bias) << " (n.v " << num(t.NoV)
+          << ") -> specular " << vec(t.specular) << "\n";
+        o << "    occlusion " << num(t.occlusion) << "; diffuse + specular = " << vec(sh.ambient) << "\n";
+    } else {
+        o << "  ambient " << vec(s.settings.ambient) << " * albedo * occlusion = " << vec(sh.ambient) << "\n";
+    }
+    o << "  shaded colour (emissive + contributions + " << (sh.ibl ? "environment" : "ambient") << ") "
+      << vec(sh.Lo) << "\n";
     if (!sh.matches_shade_surface) o << "  NOTE: shade_surface() gives a different value\n";
 }
 
@@ -643,7 +655,7 @@ std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExpl
             o << " s" << i << " (" << num(pattern.pixel_x(i)) << ", " << num(pattern.pixel_y(i)) << ")";
         o << "\n";
     }
-    o << "history: cleared to (0, 0, 0) depth 1, then " << px.history.size() << " fragment"
+    o << "history: cleared to " << vec(px.background) << " depth 1, then " << px.history.size() << " fragment"
       << (px.history.size() == 1 ? "" : "s") << " in submission order\n";
     for (std::size_t i = 0; i < px.history.size(); ++i) {
         const HistoryEntry& h = px.history[i];
@@ -711,7 +723,7 @@ std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExpl
         o << "resolve: the average of the " << S << " samples (summed pairwise) = " << vec(px.linear) << "\n";
     }
     if (px.contributors.empty()) {
-        o << "no fragment was written: the background\n";
+        o << "no fragment was written: the background " << vec(px.background) << "\n";
     } else {
         for (int k : px.contributors) {
             const HistoryEntry& w = px.history[std::size_t(k)];
@@ -735,6 +747,7 @@ json pixel_json(const StepScene& s, const Recording& rec, const PixelExplanation
     j["x"] = px.x;
     j["y"] = px.y;
     j["samples"] = px.samples;
+    j["background"] = j3(px.background);
     json hist = json::array();
     for (const HistoryEntry& h : px.history) {
         json e;

@@ -55,6 +55,7 @@ struct PixelExplanation {
     int sample_owner[kMaxSamples];         // history index whose colour sample s holds; -1: cleared
     glm::vec3 sample_color[kMaxSamples];   // each sample's final linear colour
     float sample_depth[kMaxSamples];
+    glm::vec3 background{0.0f};            // what every sample clears to: render's background here
     std::vector<int> contributors;         // history indices owning samples, most samples first
     glm::vec3 linear{0.0f};       // the resolve of the samples: what render --output .hdr writes
     glm::vec3 framebuffer{0.0f};  // the recorded frame's value (equal to linear, or a NOTE says so)

@@ -1,6 +1,6 @@
 // The frame, drawn the way SceneRenderer::render draws it (one frame: cleared
-// in the tile pass, one draw per mesh with the PBR program, in scene order,
-// with render's samples per pixel), with two additions
+// to the background in the tile pass, one draw per mesh with the PBR program,
+// in scene order, with render's samples per pixel), with two additions
 // for the stepper: a stage observer (raster/observer.h) and a limit on the
 // number of triangles, for "the image after the first N triangles".
 // tests/test_step.cpp proves the result equal to `render`'s, byte for byte.
@@ -27,13 +27,13 @@ inline const BoundMaterial& draw_material(const StepScene& s, const Mesh& mesh) 
                                                                             : kFallbackBound;
 }
 
-inline ShadingContext shading_context(const FrameSettings& s) {
-    ShadingContext ctx;
-    ctx.eye = s.camera.eye;
-    ctx.lights = s.lights;
-    ctx.ambient = s.ambient;
-    ctx.model = s.model;
-    return ctx;
+// render's shading context: lights, eye, and the environment with its tables
+// (SceneRenderer::shading_context, which builds them on first use).
+inline ShadingContext shading_context(const StepScene& s) { return s.scene_renderer->shading_context(s.settings); }
+
+// render's background (what every sample clears to) for a frame of width x height.
+inline BackgroundFill frame_background(const StepScene& s, int width, int height) {
+    return prast::frame_background(s.settings, s.scene_renderer->environment(s.settings), width, height);
 }
 
 // The state a mesh draws with, as SceneRenderer::render sets it.
@@ -65,11 +65,13 @@ void draw_frame(StepScene& s, Framebuffer& fb, MakeTap&& make_tap,
     taps.reserve(s.scene.meshes.size());  // submit() keeps a pointer to each tap
     Renderer& renderer = *s.renderer;
     renderer.begin_frame();
-    FrameOptions frame;  // cleared to black, alpha 1, depth 1, in the tile pass
+    const ShadingContext ctx = shading_context(s);
+    FrameOptions frame;  // cleared to the background, alpha 1, depth 1, in the tile pass
     frame.samples = s.settings.samples;
     frame.visibility = s.settings.visibility;
+    const BackgroundFill background = frame_background(s, fb.width, fb.height);
+    background.attach(frame);
     renderer.begin(fb, frame);
-    const ShadingContext ctx = shading_context(s.settings);
     const float aspect = float(fb.width) / float(fb.height);
     const glm::mat4 vp = s.settings.camera.view_projection(aspect);
     std::uint64_t first = 0;

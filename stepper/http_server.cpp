@@ -1,7 +1,9 @@
 // The HTTP server (cpp-httplib); see http_server.h.
 #include "stepper/http_server.h"
 
+#include <cctype>
 #include <cstdio>
+#include <ctime>
 #include <map>
 #include <mutex>
 
@@ -17,6 +19,17 @@ namespace prast::stepper {
 namespace {
 
 using nlohmann::json;
+
+// Limits against slow, idle and flooding clients (see the README's step
+// section): a connection must send something every kReadTimeoutSeconds, an
+// idle keep-alive connection is closed after kKeepAliveSeconds, and one
+// connection serves at most kKeepAliveRequests requests.
+constexpr std::size_t kServerThreads = 16;
+constexpr time_t kReadTimeoutSeconds = 2;
+constexpr time_t kWriteTimeoutSeconds = 5;
+constexpr time_t kKeepAliveSeconds = 2;
+constexpr std::size_t kKeepAliveRequests = 20;
+constexpr std::size_t kMaxBodyBytes = 4096;
 
 // A request error: the status and a one-line message.
 struct BadRequest {
@@ -37,12 +50,50 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
 // An integer query parameter in [lo, hi].
 long int_param(const httplib::Request& req, const char* name, long lo, long hi) {
     if (!req.has_param(name)) throw BadRequest{400, std::string("missing parameter '") + name + "'"};
+    if (req.get_param_value_count(name) > 1) throw BadRequest{400, std::string("parameter '") + name + "' given twice"};
     const std::string v = req.get_param_value(name);
     long out = 0;
     if (!parse_int(v, lo, hi, out))
         throw BadRequest{400, std::string("parameter '") + name + "': expected an integer in " + std::to_string(lo) +
                                   ".." + std::to_string(hi)};
     return out;
+}
+
+bool equals_lower(const std::string& s, const char* lower) {
+    std::size_t i = 0;
+    for (; i < s.size() && lower[i]; ++i)
+        if (std::tolower(static_cast<unsigned char>(s[i])) != lower[i]) return false;
+    return i == s.size() && !lower[i];
+}
+
+// DNS rebinding: a page on the web whose name resolves to 127.0.0.1 reaches
+// this server with its own name in Host; only our names are accepted (with
+// no port or ours).
+bool host_allowed(const std::string& host, int port) {
+    std::string name = host;
+    const std::size_t colon = host.rfind(':');
+    if (colon != std::string::npos) {
+        if (host.substr(colon + 1) != std::to_string(port)) return false;
+        name = host.substr(0, colon);
+    }
+    return name == "127.0.0.1" || equals_lower(name, "localhost");
+}
+
+// A request a browser made for another origin's page (an <img>, a form, a
+// fetch from a site, or from another server on this machine): browsers name
+// the page's origin in Origin and say in Sec-Fetch-Site whether it is ours.
+// Requests from our page or typed in the address bar pass; so do clients
+// that send neither (curl, scripts).
+bool cross_origin(const httplib::Request& req, int port) {
+    if (req.has_header("Origin")) {
+        const std::string origin = req.get_header_value("Origin"), p = ":" + std::to_string(port);
+        if (origin != "http://127.0.0.1" + p && origin != "http://localhost" + p) return true;
+    }
+    if (req.has_header("Sec-Fetch-Site")) {
+        const std::string site = req.get_header_value("Sec-Fetch-Site");
+        if (site != "same-origin" && site != "none") return true;
+    }
+    return false;
 }
 
 } // namespace
@@ -128,7 +179,24 @@ int serve(Session& session, int port) {
         }
         send_error(res, 500, what);
     });
-    server.set_payload_max_length(4096);
+    server.set_payload_max_length(kMaxBodyBytes);
+    // Idle and slow connections (a browser's keep-alive, a stalled client)
+    // hold a worker only briefly; more workers than cores, because requests
+    // wait for the session's lock anyway and a stalled socket costs no CPU.
+    server.set_read_timeout(kReadTimeoutSeconds, 0);
+    server.set_write_timeout(kWriteTimeoutSeconds, 0);
+    server.set_keep_alive_timeout(kKeepAliveSeconds);
+    server.set_keep_alive_max_count(kKeepAliveRequests);
+    server.new_task_queue = [] { return new httplib::ThreadPool(kServerThreads); };
+    // Responses are never sniffed as another type, never framed, never
+    // cached; the page loads only its own files (no inline script, no CDN).
+    server.set_default_headers({
+        {"X-Content-Type-Options", "nosniff"},
+        {"Cache-Control", "no-store"},
+        {"Referrer-Policy", "no-referrer"},
+        {"Content-Security-Policy", "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'; "
+                                    "connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'none'"},
+    });
 
     int bound = port;
     if (port == 0) bound = server.bind_to_any_port("127.0.0.1");
@@ -137,6 +205,25 @@ int serve(Session& session, int port) {
         std::fprintf(stderr, "step: cannot listen on 127.0.0.1:%d (in use? try --port 0)\n", port);
         return 1;
     }
+    // Before any route: our Host names only, read-only methods, no body
+    // (httplib does not read a GET's body, so it would be parsed as the
+    // next request on the connection).
+    server.set_pre_routing_handler([bound](const httplib::Request& req, httplib::Response& res) {
+        if (req.get_header_value_count("Host") != 1 || !host_allowed(req.get_header_value("Host"), bound)) {
+            send_error(res, 403, "the Host header must be 127.0.0.1 or localhost (with this server's port)");
+        } else if (cross_origin(req, bound)) {
+            send_error(res, 403, "a request from another site's page");
+        } else if (req.method != "GET" && req.method != "HEAD") {
+            res.set_header("Allow", "GET, HEAD");
+            send_error(res, 405, "read-only: only GET and HEAD");
+        } else if (req.has_header("Transfer-Encoding") ||
+                   (req.has_header("Content-Length") && req.get_header_value("Content-Length") != "0")) {
+            send_error(res, 400, "a GET request has no body");
+        } else {
+            return httplib::Server::HandlerResponse::Unhandled;
+        }
+        return httplib::Server::HandlerResponse::Handled;
+    });
     std::printf("step: serving http://127.0.0.1:%d/ (Ctrl-C to stop)\n", bound);
     std::fflush(stdout);
     server.listen_after_bind();

@@ -161,7 +161,13 @@ LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const
         Lo += st.contribution;
         r.lights.push_back(st);
     }
-    r.ambient = ctx.ambient * r.ms.albedo * r.ms.occlusion;
+    r.ibl = ctx.env != nullptr;
+    if (r.ibl) {
+        r.ibl_terms = ibl_terms(r.ms, r.sp, ctx);
+        r.ambient = r.ibl_terms.diffuse + r.ibl_terms.specular;
+    } else {
+        r.ambient = ctx.ambient * r.ms.albedo * r.ms.occlusion;
+    }
     Lo += r.ambient;
     r.Lo = Lo;
     const glm::vec3 ref = shade_surface(r.ms, r.sp, ctx);

@@ -69,7 +69,9 @@ struct LaneShading {
     bool killed = false;                // alpha MASK discarded it
     BrdfInputs inputs;
     std::vector<LightStep> lights;
-    glm::vec3 ambient{0.0f};            // ambient * albedo * occlusion
+    glm::vec3 ambient{0.0f};            // ambient * albedo * occlusion, or the environment's split sum
+    bool ibl = false;                   // lit by an environment: ambient = ibl_terms.diffuse + .specular
+    IblTerms ibl_terms;
     glm::vec3 Lo{0.0f};                 // the colour the shader wrote
     bool matches_shade_surface = true;  // Lo == shade_surface(): always, or the stepper is wrong
 };

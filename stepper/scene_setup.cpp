@@ -7,6 +7,8 @@
 
 #include "scene/camera.h"
 #include "scene/default_scene.h"
+#include "scene/image.h"
+#include "scene/load_environment.h"
 #include "scene/load_scene.h"
 
 namespace prast::stepper {
@@ -58,11 +60,23 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
         return false;
     }
 
-    // Lights: the scene's and the flags'; the default rig only when neither has any.
+    // The environment: --env, or the scene's own (the built-in sky).
+    std::shared_ptr<const Image> env_image = out.scene.environment;
+    if (!opt.env.empty()) {
+        try {
+            env_image = std::make_shared<const Image>(load_environment_hdr(opt.env));
+        } catch (const LoadError& e) {
+            err = {1, e.what()};
+            return false;
+        }
+    }
+
+    // Lights: the scene's and the flags'; the default rig only when neither
+    // has any and no environment lights the scene.
     FrameSettings& s = out.settings;
     s.lights = shading_lights(out.scene);
     s.lights.insert(s.lights.end(), opt.lights.begin(), opt.lights.end());
-    if (s.lights.empty() && !opt.no_default_lights) {
+    if (s.lights.empty() && !opt.no_default_lights && !env_image) {
         s.lights = default_light_rig();
         out.notes.push_back("no lights in the scene or flags: using the default key+fill rig "
                             "(--no-default-lights to disable)");
@@ -70,6 +84,9 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     s.ambient = opt.ambient;
     s.model = opt.brdf;
     s.view = DebugView::None;
+    s.energy = opt.energy;
+    s.background = opt.background;
+    s.background_color = opt.background_color;
     s.samples = opt.samples;
 
     // Frame 0 of render's turntable loop.
@@ -90,6 +107,14 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     ro.tile_size = opt.tile_size;
     out.renderer = std::make_unique<Renderer>(ro);
     out.scene_renderer = std::make_unique<SceneRenderer>(out.scene, *out.renderer);
+    if (env_image) {
+        EnvironmentSettings es;
+        es.intensity = opt.env_intensity;
+        es.rotate_deg = opt.env_rotate_deg;
+        out.environment = std::make_unique<Environment>(Environment::build(*env_image, es, out.renderer->pool()));
+    }
+    s.environment = out.environment.get();
+    s.scene_environment = false;
     for (const std::string& w : out.scene_renderer->warnings()) out.notes.push_back("warning: " + w);
     return true;
 }

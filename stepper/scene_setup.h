@@ -30,6 +30,11 @@ struct FrameRequest {
     glm::vec3 ambient{0.03f};
     bool no_default_lights = false;
     BrdfModel brdf = BrdfModel::Default;
+    std::string env;                         // --env FILE.hdr; empty: the scene's own, if any
+    float env_intensity = 1.0f, env_rotate_deg = 0.0f;
+    Background background = Background::Env;
+    glm::vec3 background_color{0.0f};
+    bool energy = false;                     // --energy conserve
     float exposure = 1.0f;
     ToneMap tonemap = ToneMap::Aces;         // render's effective tone map
     int threads = 0;
@@ -44,6 +49,7 @@ struct StepScene {
     FrameSettings settings;          // camera (frame 0), lights, ambient, BRDF
     std::unique_ptr<Renderer> renderer;
     std::unique_ptr<SceneRenderer> scene_renderer;
+    std::unique_ptr<Environment> environment;  // prefiltered as render does, when there is one
     std::vector<std::string> notes;  // warnings and the default-rig note, for stderr
     int width() const { return options.width; }
     int height() const { return options.height; }

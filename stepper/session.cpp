@@ -60,7 +60,7 @@ std::string count_range(long n) { return n > 0 ? "0.." + std::to_string(n - 1) :
 class VerifyObserver {
 public:
     VerifyObserver(const StepScene& s, const Recording& rec)
-        : s_(s), rec_(rec), ctx_(shading_context(s.settings)), cursor_(rec.tiles.size(), 0) {}
+        : s_(s), rec_(rec), ctx_(shading_context(s)), cursor_(rec.tiles.size(), 0) {}
 
     // The observer of one draw.
     struct Tap {

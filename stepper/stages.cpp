@@ -456,7 +456,7 @@ void draw_stages(StepScene& s, const Recording& rec, const std::vector<std::stri
     if (surface.empty()) return;
     // Shade every pixel's winning fragment again, a tile per task: each
     // block that wins a pixel is replayed once, each winning lane shaded.
-    const ShadingContext ctx = shading_context(s.settings);
+    const ShadingContext ctx = shading_context(s);
     s.renderer->pool().run(int(rec.tiles.size()), [&](int tile, int) {
         const TileRecord& t = rec.tiles[std::size_t(tile)];
         const int ts = rec.tile_size;

@@ -195,6 +195,17 @@ TEST_CASE("pixel: NormalTangentTest's explained pixels are render's") {
     CHECK(check_pixels_against_render(kNormalTangentFlags, 10, 8) > 30);
 }
 
+TEST_CASE("pixel: under an --env map with --energy conserve, the explained pixels are render's") {
+    const std::string venice = kAssets + "/venice-sunset-1k/venice_sunset_1k.hdr";
+    if (!have_asset(venice)) return;
+    const std::vector<std::string> flags = {"--size", "160x90", "--env", venice, "--env-rotate", "40",
+                                            "--energy", "conserve", "--brdf", "gltf"};
+    CHECK(check_pixels_against_render(flags, 12, 6) > 20);  // --msaa 4: edge samples resolve to the sky
+    std::vector<std::string> one = flags;
+    for (const char* f : {"--msaa", "1", "--background", "blur"}) one.push_back(f);
+    CHECK(check_pixels_against_render(one, 12, 6) > 20);
+}
+
 TEST_CASE("pixel: with 1 and 8 samples per pixel too, the explained pixels are render's") {
     for (const char* msaa : {"1", "8"}) {
         INFO("--msaa " << msaa);
@@ -218,8 +229,10 @@ TEST_CASE("verify: every recomputed number equals the pipeline's") {
 
 TEST_CASE("upto: all triangles give render's image, none the cleared frame") {
     CliSandbox box;
-    REQUIRE(box.run_exe(kRender, {"--size", "320x180", "-o", "r.png"}).code == 0);
-    const CliRun r = run_step(box, {"--size", "320x180"}, "upto 98432 all.png\nupto 0 none.png\nupto 50000\n");
+    // With a black background (the built-in sky otherwise), no triangle is a black frame.
+    REQUIRE(box.run_exe(kRender, {"--size", "320x180", "--background", "black", "-o", "r.png"}).code == 0);
+    const CliRun r = run_step(box, {"--size", "320x180", "--background", "black"},
+                              "upto 98432 all.png\nupto 0 none.png\nupto 50000\n");
     REQUIRE(r.code == 0);
     CHECK(r.out.find("upto 50000: wrote upto-50000.png") != std::string::npos);
     const Rgb8 want = load_rgb8(box.path("r.png")), all = load_rgb8(box.path("all.png"));
@@ -233,8 +246,11 @@ TEST_CASE("upto: all triangles give render's image, none the cleared frame") {
 
 TEST_CASE("--out: every stage as a PNG and an index.html; the final stage is render's image") {
     CliSandbox box;
-    REQUIRE(box.run_exe(kRender, {"--size", "320x180", "-o", "r.png"}).code == 0);
-    const CliRun r = box.run_exe(kStep, {"--size", "320x180", "--out", "stages"});
+    // A magenta background (the built-in sky otherwise), so that render's
+    // empty pixels can be told from drawn ones below (a metal seen exactly
+    // edge-on under the sky alone is black).
+    REQUIRE(box.run_exe(kRender, {"--size", "320x180", "--background", "1,0,1", "-o", "r.png"}).code == 0);
+    const CliRun r = box.run_exe(kStep, {"--size", "320x180", "--background", "1,0,1", "--out", "stages"});
     REQUIRE(r.code == 0);
     const std::string index = read_text(box.work() / "stages" / "index.html");
     const char* kStages[] = {"vertices", "wireframe", "bins", "depth", "overdraw", "shaded", "msaa", "quad_overdraw",
@@ -259,7 +275,8 @@ TEST_CASE("--out: every stage as a PNG and an index.html; the final stage is ren
     int background = 0;
     for (int y = 0; y < 180; ++y)
         for (int x = 0; x < 320; ++x) {
-            const bool empty = want.at(x, y)[0] == 0 && want.at(x, y)[1] == 0 && want.at(x, y)[2] == 0;
+            const std::uint8_t* bg = want.at(0, 0);  // the top-left corner shows the background
+            const bool empty = want.at(x, y)[0] == bg[0] && want.at(x, y)[1] == bg[1] && want.at(x, y)[2] == bg[2];
             background += empty;
             if (empty) CHECK(albedo.at(x, y)[0] + albedo.at(x, y)[1] + albedo.at(x, y)[2] == 0);
             else CHECK(albedo.at(x, y)[0] + albedo.at(x, y)[1] + albedo.at(x, y)[2] > 0);
@@ -271,6 +288,42 @@ TEST_CASE("--out: every stage as a PNG and an index.html; the final stage is ren
     const CliRun bad = box.run_exe(kStep, {"--size", "32x18", "--out", "afile"});
     CHECK(bad.code == 1);
     CHECK(bad.err.find("afile") != std::string::npos);
+}
+
+TEST_CASE("stage wireframe: set-up triangles white, clipped pieces orange, culled dark blue, degenerate magenta") {
+    // The colours as stepper/stages.cpp writes them (linear * 255, no sRGB).
+    const std::uint8_t kWhite[3] = {255, 255, 255}, kOrange[3] = {255, 140, 26}, kBlue[3] = {38, 51, 153},
+                       kMagenta[3] = {255, 0, 255};
+    auto count = [](const Rgb8& img, const std::uint8_t* c) {
+        int n = 0;
+        for (std::size_t i = 0; i < img.rgb.size(); i += 3) n += std::memcmp(&img.rgb[i], c, 3) == 0;
+        return n;
+    };
+    CliSandbox box;
+    REQUIRE(run_step(box, {"--size", "320x180"}, "stage wireframe whole.png\n").code == 0);
+    REQUIRE(run_step(box, {"--size", "320x180", "--near", "6.5", "--far", "20"}, "stage wireframe cut.png\n").code == 0);
+    const Rgb8 whole = load_rgb8(box.path("whole.png")), cut = load_rgb8(box.path("cut.png"));
+    REQUIRE(!whole.empty());
+    REQUIRE(!cut.empty());
+    // Nothing is clipped in the built-in frame; the near plane through the
+    // floor clips some triangles, drawn in their own colour.
+    CHECK(count(whole, kOrange) == 0);
+    CHECK(count(cut, kOrange) > 100);
+    for (const Rgb8* img : {&whole, &cut}) {
+        CHECK(count(*img, kWhite) > 1000);
+        CHECK(count(*img, kBlue) > 0);     // back faces seen past the silhouettes
+        CHECK(count(*img, kMagenta) > 0);  // the scene's degenerate triangles
+    }
+}
+
+TEST_CASE("--out: names from the model reach index.html escaped") {
+    CliSandbox box;
+    write_text(box.work() / "<i>&x.obj", "o <script>alert(1)</script>\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const CliRun r = box.run_exe(kStep, {"--size", "32x18", "<i>&x.obj", "--out", "o"});
+    REQUIRE(r.code == 0);
+    const std::string index = read_text(box.work() / "o" / "index.html");
+    CHECK(index.find("<i>") == std::string::npos);
+    CHECK(index.find("&lt;i&gt;&amp;x.obj") != std::string::npos);
 }
 
 TEST_CASE("sessions: the built-in scene, step by step") {

@@ -11,7 +11,10 @@ requests (4xx JSON, the server still answering afterwards).
 usage: test_step_page.py STEP_EXE [--api]
 With --api, no browser: the JSON API only (every endpoint, the pixel text
 against the terminal front end's, and a bounded loop of malformed requests
-that must all get 4xx JSON errors while the server keeps answering).
+that must all get 4xx JSON errors while the server keeps answering), then
+the hostile-input checks of hostile_http.py (Host header, methods, bodies,
+traversal, numbers, malformed requests, limits, slow and concurrent
+clients, a seeded fuzz loop, 127.0.0.1 only).
 Without it, exit 77 (CTest: skipped) when chromium, chromedriver or
 python3-selenium is missing, unless PRAST_BROWSER_REQUIRED=1 (CI) makes
 that a failure.
@@ -23,10 +26,12 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 import urllib.error
 import urllib.parse
 import urllib.request
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+import hostile_http  # noqa: E402
 
 SKIP = 77
 FLAGS = ["--size", "320x180", "--threads", "2"]
@@ -152,6 +157,8 @@ def api_checks(step):
         assert code == 200 and server.poll() is None
         print("api: every endpoint answers as the terminal front end does; %d malformed requests got 4xx JSON"
               % len(bad))
+        hostile_http.run(int(base.rsplit(":", 1)[1]), frame)
+        assert server.poll() is None
     finally:
         stop_server(server)
 
@@ -174,7 +181,7 @@ def main():
         from selenium.webdriver.chrome.service import Service
         from selenium.webdriver.common.action_chains import ActionChains
         from selenium.webdriver.common.by import By
-        from selenium.webdriver.support.ui import WebDriverWait
+        from selenium.webdriver.support.ui import Select, WebDriverWait
     except ImportError:
         skip("python3-selenium is not installed (apt-get install python3-selenium)")
 
@@ -232,6 +239,22 @@ def main():
         wait.until(lambda d: d.find_element(By.ID, "tri-text").get_attribute("textContent").startswith("tri %d:" % tri))
         assert driver.find_element(By.ID, "tri-text").get_attribute("textContent") == step_text(step, "tri %d\n" % tri)
         print("tri %d: the page shows step's setup exactly" % tri)
+
+        # The clicked pixel's tile: its bins as `tile TX TY` prints them.
+        tx, ty = x // frame["tile_size"], y // frame["tile_size"]
+        wait.until(lambda d: d.find_element(By.ID, "tile-coords").text == "%d %d" % (tx, ty))
+        wait.until(lambda d: d.find_element(By.ID, "tile-text").get_attribute("textContent").startswith("tile "))
+        assert driver.find_element(By.ID, "tile-text").get_attribute("textContent") == \
+            step_text(step, "tile %d %d\n" % (tx, ty))
+        print("tile %d %d: the page shows step's bins exactly" % (tx, ty))
+
+        # Switching stages: the depth stage's image and its sentence.
+        Select(driver.find_element(By.ID, "stage")).select_by_value("depth")
+        wait.until(lambda d: "/api/stage?name=depth" in img.get_attribute("src"))
+        wait.until(lambda d: d.execute_script("return arguments[0].complete && arguments[0].naturalWidth", img) == 320)
+        about = {st["name"]: st["about"] for st in get(url.rstrip("/") + "/api/stages")[1]}
+        assert driver.find_element(By.ID, "stage-about").get_attribute("textContent") == about["depth"]
+        print("stage: switched to depth, its image and sentence shown")
 
         # The slider: the frame after the first 1000 triangles.
         driver.execute_script("const u = document.getElementById('upto'); u.value = 1000;"
