@@ -3,12 +3,16 @@
 // camera, and renders one image or a turntable with the library's
 // SceneRenderer; everything else lives in shading/ and raster/. Errors are one
 // line on stderr, "render: ...": exit code 2 for usage, 1 for bad files and
-// failed writes. Output is written atomically (temporary file, then rename).
+// failed writes. Output is written atomically (temporary file, then rename);
+// SIGINT/SIGTERM remove the temporary file and end the process by the signal
+// (exit status 130/143). Every stderr line passes through printable(), so
+// nothing a model holds reaches the terminal as a control character.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -16,7 +20,9 @@
 #include <filesystem>
 #include <mutex>
 #include <new>
+#include <set>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -30,8 +36,9 @@
 #include "scene/default_scene.h"
 #include "scene/image.h"
 #include "scene/load_environment.h"
-#include "scene/write_image.h"
 #include "scene/load_scene.h"
+#include "scene/messages.h"
+#include "scene/write_image.h"
 #include "shading/environment.h"
 #include "shading/scene_renderer.h"
 #include "shading/surface.h"
@@ -52,13 +59,44 @@ double ms_since(Clock::time_point t0) {
 constexpr int kExitBadFile = 1;
 constexpr int kExitUsage = 2;
 
+// What the render is doing, for "out of memory while ..." (main thread only).
+std::string g_stage = "starting";
+
+// SIGINT, SIGTERM, SIGHUP: remove the temporary output file, then die by the
+// same signal (SA_RESETHAND restored the default action), so the shell sees
+// 130/143 and a script's loop stops as it should.
+extern "C" void on_fatal_signal(int sig) {
+    remove_temporary_output();
+    raise(sig);
+}
+
+void install_signal_cleanup() {
+    struct sigaction sa;
+    std::memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_fatal_signal;
+    sa.sa_flags = SA_RESETHAND;
+    sigemptyset(&sa.sa_mask);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+        // A signal ignored at start stays ignored (a background job's SIGINT).
+        struct sigaction old;
+        if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        sigaction(sig, &sa, nullptr);
+    }
+}
+
 // A progress bar on stderr, drawn by its own thread every 200 ms once the job
 // has run for a second, and only when stderr is a terminal. Other stderr lines
 // go through note() so they never land in the middle of the bar.
 class Progress {
 public:
     explicit Progress(int total_steps) : total_(std::max(1, total_steps)) {
-        if (isatty(STDERR_FILENO)) thread_ = std::thread([this] { loop(); });
+        // No bar rather than no render when a thread cannot be started.
+        if (isatty(STDERR_FILENO)) {
+            try {
+                thread_ = std::thread([this] { loop(); });
+            } catch (const std::system_error&) {
+            }
+        }
     }
     ~Progress() { finish(); }
 
@@ -70,7 +108,7 @@ public:
     void note(const std::string& line) {
         std::lock_guard<std::mutex> lock(mutex_);
         clear_line();
-        std::fprintf(stderr, "%s\n", line.c_str());
+        std::fprintf(stderr, "%s\n", printable(line).c_str());
     }
     void finish() {
         if (!thread_.joinable()) return;
@@ -94,7 +132,7 @@ private:
             std::string bar(std::size_t(filled), '#');
             bar.append(std::size_t(kWidth - filled), '.');
             std::fprintf(stderr, "\rrender: [%s] %d/%d %s  %.1f s\033[K", bar.c_str(), step_, total_,
-                         label_.c_str(), seconds);
+                         printable(label_).c_str(), seconds);
             std::fflush(stderr);
             shown_ = true;
         }
@@ -132,6 +170,134 @@ std::string check_output_path(const std::string& path) {
     close(fd);
     unlink(probe.c_str());
     return "";
+}
+
+// "" when every frame of [first, last] can be written: each distinct
+// directory is probed once, before the first frame is rendered.
+std::string check_output_paths(const render_cli::FramePattern& pattern, int first, int last) {
+    std::set<std::string> dirs;
+    std::error_code ec;
+    for (int frame = first; frame <= last; ++frame) {
+        const std::string path = pattern.format(frame);
+        if (fs::is_directory(path, ec)) return path + ": is a directory, not an output file";
+        if (!dirs.insert(fs::path(path).parent_path().string()).second) continue;
+        const std::string err = check_output_path(path);
+        if (!err.empty()) return err;
+        if (!pattern.has_number) break;
+    }
+    return "";
+}
+
+// The camera, checked before anything is drawn: every coordinate within
+// kMaxCameraCoordinate (beyond it the view matrix overflows single
+// precision), eye and target apart, up not along the view. The message blames
+// what is wrong: a flag (exit 2), or the scene's bounds when the framing came
+// from them (exit 1). "" when the camera can render.
+std::string check_camera(const Camera& cam, const RenderOptions& opt, const Bounds& bounds, bool framed,
+                         int& code) {
+    const auto fits = [](const glm::dvec3& v) {
+        return std::fabs(v.x) <= kMaxCameraCoordinate && std::fabs(v.y) <= kMaxCameraCoordinate &&
+               std::fabs(v.z) <= kMaxCameraCoordinate;
+    };
+    const auto vec = [](const glm::dvec3& v) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "%g,%g,%g", v.x, v.y, v.z);
+        return std::string(buf);
+    };
+    const std::string scene = opt.scene;
+    const glm::dvec3 lo(bounds.lo), hi(bounds.hi);
+    const bool bounds_fit = bounds.empty() || (fits(lo) && fits(hi) && fits(hi - lo));
+    const std::string bounds_text = bounds.empty() ? "empty" : "from " + vec(lo) + " to " + vec(hi);
+    code = kExitBadFile;
+    if (framed && (!opt.eye || !opt.target) && !bounds_fit)
+        return scene + ": cannot frame the scene: its bounds (" + bounds_text +
+               ") reach beyond +-1e18, where single precision breaks down; give --eye and --target (and --near, --far)";
+    if (framed && (!opt.near_plane || !opt.far_plane) && !bounds_fit)
+        return scene + ": cannot fit clip planes to the scene: its bounds (" + bounds_text +
+               ") reach beyond +-1e18; give --near and --far";
+    const glm::dvec3 eye(cam.eye), target(cam.target);
+    if (!fits(eye) || !fits(target)) {
+        // Framing put the eye too far: the field of view was too narrow for the scene.
+        code = kExitUsage;
+        if (opt.fov_deg < 45.0f)
+            return "--fov " + std::to_string(opt.fov_deg) + ": framing the scene (bounds " + bounds_text +
+                   ") this narrowly puts the eye at " + vec(eye) + ", beyond +-1e18; give a wider --fov or --eye";
+        code = kExitBadFile;
+        return scene + ": cannot frame the scene: its bounds (" + bounds_text + ") put the eye at " + vec(eye) +
+               ", beyond +-1e18; give --eye and --target";
+    }
+    code = kExitUsage;
+    const glm::dvec3 view = target - eye;
+    if (!(glm::length(view) > 0.0)) {
+        if (opt.eye && opt.target) return "--eye/--target: the eye and the target are the same point";
+        if (opt.eye) return "--eye " + vec(eye) + ": the framed target (the scene's centre) is there too; give --target";
+        if (opt.target) return "--target " + vec(target) + ": the framed eye is there too; give --eye";
+        code = kExitBadFile;
+        return scene + ": cannot frame the scene: its bounds (" + bounds_text +
+               ") are too small for their distance from the origin in single precision";
+    }
+    const glm::dvec3 up = glm::dvec3(cam.up);
+    if (!(glm::length(glm::cross(glm::normalize(view), up)) > 1e-4)) {
+        if (opt.up) return "--up: parallel to the viewing direction (eye to target); give another --up";
+        return "--eye/--target: the view is vertical, along the default up 0,1,0; give --up";
+    }
+    return "";
+}
+
+// Bytes a render holds at its peak, estimated before the textures are decoded
+// or a frame drawn: the scene as loaded, the decoded textures with their mip
+// chains (the file's bytes per texel, 16 for float RGBA; 4/3 for the chain),
+// the pipeline's per-vertex and per-triangle work for the largest mesh, the
+// framebuffer and 8-bit image.
+struct MemoryPlan {
+    std::uint64_t scene = 0, textures = 0, pipeline = 0, image = 0;
+    std::uint64_t texels = 0;
+    std::size_t images = 0;
+    std::uint64_t total() const { return scene + textures + pipeline + image; }
+};
+
+constexpr std::uint64_t kPipelineBytesPerVertex = 96;             // clip position and varyings
+constexpr std::uint64_t kPipelineBytesPerTriangle = 96;           // set-up edges and bin entries
+
+MemoryPlan plan_memory(const Scene& scene, const RenderOptions& opt) {
+    MemoryPlan plan;
+    std::size_t max_vertices = 0, max_triangles = 0;
+    for (const Mesh& m : scene.meshes) {
+        plan.scene += m.positions.size() * sizeof(glm::vec3) + m.normals.size() * sizeof(glm::vec3) +
+                      m.uvs.size() * sizeof(glm::vec2) + m.tangents.size() * sizeof(glm::vec4) +
+                      m.indices.size() * sizeof(std::uint32_t);
+        max_vertices = std::max(max_vertices, m.positions.size());
+        max_triangles = std::max(max_triangles, m.indices.size() / 3);
+    }
+    plan.pipeline = max_vertices * kPipelineBytesPerVertex + max_triangles * kPipelineBytesPerTriangle;
+    // Each (image, colour space) a material uses is one texture.
+    std::set<std::pair<int, bool>> used;
+    for (const Material& m : scene.materials) {
+        for (const TextureRef* r : {&m.base_color, &m.emissive}) used.insert({r->image, true});
+        for (const TextureRef* r : {&m.metallic_roughness, &m.roughness, &m.metallic, &m.normal, &m.occlusion})
+            used.insert({r->image, false});
+    }
+    std::vector<int> per_image(scene.images.size(), 0);
+    for (const auto& u : used)
+        if (u.first >= 0 && std::size_t(u.first) < scene.images.size()) ++per_image[std::size_t(u.first)];
+    for (std::size_t i = 0; i < scene.images.size(); ++i) {
+        if (per_image[i] == 0) continue;
+        int w = 0, h = 0, texel_bytes = 16;
+        const ImageSource& src = scene.images[i];
+        if (src.decoded) {
+            w = src.decoded->width;
+            h = src.decoded->height;
+            texel_bytes = src.decoded->is_8bit() ? src.decoded->channels : 16;
+        } else if (!image_dimensions(src, w, h, &texel_bytes)) {
+            continue;  // decoding will fail and say why
+        }
+        const std::uint64_t texels = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(per_image[i]);
+        plan.texels += texels;
+        plan.textures += texels * std::uint64_t(texel_bytes) * 4 / 3;
+        ++plan.images;
+    }
+    plan.image = std::uint64_t(opt.width) * std::uint64_t(opt.height) * kBytesPerPixel;
+    return plan;
 }
 
 // v rotated by `radians` around the unit axis k (Rodrigues), in double so the
@@ -282,16 +448,17 @@ void print_pixel(const Scene& scene, const Camera& cam, const Framebuffer& fb, c
         return;
     }
     const Mesh& mesh = scene.meshes[std::size_t(hit.mesh)];
-    std::printf(" mesh %d '%s' triangle %zu material '%s'\n", hit.mesh, mesh.name.c_str(), hit.triangle,
-                scene.materials[std::size_t(std::max(0, mesh.material))].name.c_str());
+    std::printf(" mesh %d '%s' triangle %zu material '%s'\n", hit.mesh, printable(mesh.name).c_str(), hit.triangle,
+                printable(scene.materials[std::size_t(std::max(0, mesh.material))].name).c_str());
     if (sr.environment(settings)) print_pixel_ibl(sr, settings, mesh, hit, fb.width, fb.height, px, ibl_samples);
 }
 
 int run(int argc, char** argv) {
+    install_signal_cleanup();
     RenderOptions opt;
     const std::string usage_err = parse_render_args(argc, argv, opt);
     if (!usage_err.empty()) {
-        std::fprintf(stderr, "render: %s\n", usage_err.c_str());
+        std::fprintf(stderr, "render: %s\n", printable(usage_err).c_str());
         return kExitUsage;
     }
     if (opt.help) {
@@ -303,21 +470,20 @@ int run(int argc, char** argv) {
         return 0;
     }
 
-    // Fail on an unwritable output before spending time on the render.
+    // Fail on an unwritable output before spending time on the render: every
+    // frame's directory, so a turntable cannot fail half-way.
     const render_cli::FramePattern pattern(opt.output);
-    for (int frame : {opt.first_frame, opt.last_frame}) {
-        const std::string err = check_output_path(pattern.format(frame));
-        if (!err.empty()) {
-            std::fprintf(stderr, "render: %s\n", err.c_str());
-            return kExitBadFile;
-        }
+    const std::string out_err = check_output_paths(pattern, opt.first_frame, opt.last_frame);
+    if (!out_err.empty()) {
+        std::fprintf(stderr, "render: %s\n", printable(out_err).c_str());
+        return kExitBadFile;
     }
 
     const int frames_to_render = opt.last_frame - opt.first_frame + 1;
     Progress progress(2 + frames_to_render * opt.repeat);
     auto fail = [&](int code, const std::string& message) {
         progress.finish();
-        std::fprintf(stderr, "render: %s\n", message.c_str());
+        std::fprintf(stderr, "render: %s\n", printable(message).c_str());
         return code;
     };
 
@@ -331,29 +497,44 @@ int run(int argc, char** argv) {
         scene = std::move(d.scene);
         camera = d.camera;
     } else {
+        g_stage = "loading " + opt.scene;
+        LoadOptions load_options;
+        load_options.allow_outside_paths = opt.allow_outside_paths;
         try {
-            scene = load_scene(opt.scene);
+            scene = load_scene(opt.scene, load_options);
         } catch (const LoadError& e) {
             return fail(kExitBadFile, e.what());
         }
     }
     const double load_ms = ms_since(t_load);
-    for (const std::string& w : scene.warnings) progress.note("render: warning: " + w);
+    for (const std::string& w : cap_warnings(scene.warnings)) progress.note("render: warning: " + w);
 
     // Camera: the default scene's own, or framed on the bounds; flags override
     // single fields, and the framing fills in the rest.
     const Bounds bounds = scene.bounds();
     const float aspect = float(opt.width) / float(opt.height);
-    if (!opt.scene.empty()) camera = frame_bounds(bounds, opt.fov_deg, aspect);
+    const bool framed = !opt.scene.empty();
+    if (framed) camera = frame_bounds(bounds, opt.fov_deg, aspect);
     camera.fov_y_deg = opt.fov_deg;
     if (opt.eye) camera.eye = *opt.eye;
     if (opt.target) camera.target = *opt.target;
-    if (opt.up) camera.up = glm::normalize(*opt.up);
-    const glm::vec3 view_dir = camera.target - camera.eye;
-    if (!(glm::length(view_dir) > 0.0f))
-        return fail(kExitUsage, "--eye/--target: the eye and the target are the same point");
-    if (!(glm::length(glm::cross(glm::normalize(view_dir), camera.up)) > 1e-4f))
-        return fail(kExitUsage, "--up: parallel to the viewing direction (eye to target); give another --up");
+    if (opt.up) camera.up = glm::vec3(glm::normalize(glm::dvec3(*opt.up)));
+    int camera_code = 0;
+    const std::string camera_err = check_camera(camera, opt, bounds, framed, camera_code);
+    if (!camera_err.empty()) return fail(camera_code, camera_err);
+
+    // The whole render must fit in memory before anything big is allocated.
+    g_stage = "planning memory";
+    const MemoryPlan plan = plan_memory(scene, opt);
+    const std::uint64_t budget = render_memory_budget();
+    if (plan.total() > budget)
+        return fail(kExitBadFile,
+                    (opt.scene.empty() ? std::string("the built-in scene") : opt.scene) + ": the render needs about " +
+                        std::to_string(plan.total()) + " bytes (scene " + std::to_string(plan.scene) + ", textures " +
+                        std::to_string(plan.textures) + " for " + std::to_string(plan.texels) + " texels in " +
+                        std::to_string(plan.images) + " images, drawing " + std::to_string(plan.pipeline) + ", image " +
+                        std::to_string(plan.image) + "), more than the " + std::to_string(budget) +
+                        " bytes allowed (half the physical memory)");
 
     // The environment: --env, or the scene's own (the built-in sky).
     std::shared_ptr<const Image> env_image = scene.environment;
@@ -393,10 +574,15 @@ int run(int argc, char** argv) {
     RendererOptions ro;
     ro.threads = opt.threads;
     ro.tile_size = opt.tile_size;
+    g_stage = "starting threads";
     Renderer renderer(ro);
+    if (!renderer.pool().started_fewer().empty())
+        progress.note("render: warning: " + renderer.pool().started_fewer() + "; rendering with " +
+                      std::to_string(renderer.threads()));
+    g_stage = "decoding textures";
     SceneRenderer scene_renderer(scene, renderer);
     const double textures_ms = ms_since(t_tex);
-    for (const std::string& w : scene_renderer.warnings()) progress.note("render: warning: " + w);
+    for (const std::string& w : cap_warnings(scene_renderer.warnings())) progress.note("render: warning: " + w);
 
     // Prefilter the environment once for all frames, on the renderer's threads.
     auto t_env = Clock::now();
@@ -456,6 +642,7 @@ int run(int argc, char** argv) {
         double render_ms = 0.0;
         for (int r = 0; r < opt.repeat; ++r) {
             progress.begin(step++, "frame " + std::to_string(frame));
+            g_stage = "rendering frame " + std::to_string(frame);
             auto t0 = Clock::now();
             scene_renderer.render(settings, fb, opt.hdr_output() ? nullptr : &out8);
             render_ms = ms_since(t0);
@@ -465,6 +652,7 @@ int run(int argc, char** argv) {
         auto t_write = Clock::now();
         const std::string path = pattern.format(frame);
         progress.begin(step, "writing " + path);
+        g_stage = "writing " + path;
         try {
             if (opt.hdr_output()) write_hdr_atomic(path, fb.width, fb.height, fb.color.data());
             else write_png_atomic(path, fb.width, fb.height, rgba8.data());
@@ -498,9 +686,12 @@ int main(int argc, char** argv) {
     try {
         return run(argc, argv);
     } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "render: out of memory (try a smaller --size or a smaller scene)\n");
+        std::fprintf(stderr, "render: out of memory while %s (try a smaller --size or a smaller scene)\n",
+                     printable(g_stage).c_str());
+    } catch (const std::system_error& e) {
+        std::fprintf(stderr, "render: %s failed: %s\n", printable(g_stage).c_str(), printable(e.code().message()).c_str());
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "render: %s\n", e.what());
+        std::fprintf(stderr, "render: %s failed: %s\n", printable(g_stage).c_str(), printable(e.what()).c_str());
     }
     return kExitBadFile;
 }

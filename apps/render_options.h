@@ -40,6 +40,11 @@ constexpr std::uint64_t kBytesPerPixel = kFramebufferBytesPerPixel + kImageBytes
 // Caps on counts that no sensible job exceeds; they keep a typo (an extra
 // zero) from starting a job that runs for days.
 constexpr int kMaxThreads = 1024;
+// Camera coordinates beyond this leave single precision no room: the view
+// matrix squares distances (1e19 squared overflows a float).
+constexpr double kMaxCameraCoordinate = 1e18;
+// Below this field of view the framing distance explodes (r / sin(fov / 2)).
+constexpr double kMinFovDeg = 0.001;
 constexpr long kMaxFrames = 1000000;
 constexpr long kMaxRepeat = 100000;
 constexpr long kMaxIblSamples = 1 << 20;
@@ -90,6 +95,7 @@ struct RenderOptions {
     bool repeat_given = false;         // print the frame_ms line
     bool stats = false;
     std::optional<glm::ivec2> pixel;
+    bool allow_outside_paths = false;  // the model may name files outside its folder
     bool help = false, version = false;
 
     bool hdr_output() const;
@@ -119,10 +125,10 @@ inline const char* render_usage() {
 "  --shadows on|off --shadow-size N   shadow maps (default off, 2048 texels)\n"
 "  --threads N          default: all cores      --tile N  16..256 (default 64)\n"
 "  --frames N --orbit DEG  turntable: N images orbiting the target around --up,\n"
-"                       DEG in total (default 360); FILE needs %04d\n"
-"  --frame-range A-B    only frames A..B (0-based) of the turntable\n"
+"    DEG in total (default 360); FILE needs %04d; --frame-range A-B: frames A..B\n"
 "  --repeat N           render N times; print frame_ms min=.. median=.. max=..\n"
 "  --stats              per-stage counters and times  --pixel X,Y  probe a pixel\n"
+"  --allow-outside-paths  let the model name files outside its own folder\n"
 "  --help, --version    exit codes: 0 ok, 1 bad file or write, 2 bad usage\n";
 }
 
@@ -338,12 +344,16 @@ inline std::string parse_render_args(int argc, const char* const* argv, RenderOp
             glm::vec3 p;
             if (!parse_vec3(v, p)) return bad(v, "expected three finite numbers X,Y,Z");
             if (flag == "--up" && glm::dot(p, p) == 0.0f) return bad(v, "the up vector must not be zero");
+            if (flag != "--up" && !(std::fabs(p.x) <= kMaxCameraCoordinate && std::fabs(p.y) <= kMaxCameraCoordinate &&
+                                    std::fabs(p.z) <= kMaxCameraCoordinate))
+                return bad(v, "coordinates beyond +-1e18 cannot be rendered in single precision");
             (flag == "--eye" ? out.eye : flag == "--target" ? out.target : out.up) = p;
         } else if (flag == "--fov") {
             if (!(err = value("DEG", v)).empty()) return err;
             double d;
             if (!parse_finite(v, d)) return bad(v, "not a finite number");
-            if (!(d > 0.0 && d < 180.0)) return bad(v, "must be between 0 and 180 degrees (exclusive)");
+            if (!(d >= kMinFovDeg && d < 180.0))
+                return bad(v, "must be at least 0.001 and less than 180 degrees");
             out.fov_deg = float(d);
         } else if (flag == "--near" || flag == "--far") {
             if (!(err = value("distance", v)).empty()) return err;
@@ -502,6 +512,9 @@ inline std::string parse_render_args(int argc, const char* const* argv, RenderOp
             out.last_frame = int(b);
             out.frame_range_given = true;
             range_text = v;
+        } else if (flag == "--allow-outside-paths") {
+            if (!(err = no_value()).empty()) return err;
+            out.allow_outside_paths = true;
         } else if (flag == "--stats") {
             if (!(err = no_value()).empty()) return err;
             out.stats = true;

@@ -52,6 +52,14 @@ const char* step_usage() {
 const char* const kNotForStep[] = {"-o", "--output", "--frames", "--orbit", "--frame-range",
                                    "--repeat", "--view", "--stats"};
 
+// The loader's refusals end with a hint at render's --allow-outside-paths,
+// which step does not take.
+std::string without_outside_hint(std::string s) {
+    const std::string hint = " (--allow-outside-paths reads it)";
+    for (std::size_t at; (at = s.find(hint)) != std::string::npos;) s.erase(at, hint.size());
+    return s;
+}
+
 struct StepOptions {
     std::string out_dir;
     bool serve = false;
@@ -72,6 +80,9 @@ std::string parse_step_args(int argc, char** argv, StepOptions& so, std::vector<
             value = arg.substr(eq + 1);
             inline_value = true;
         }
+        if (flag == "--allow-outside-paths")
+            return flag + ": not a step option (step reads only files inside the model's folder: it may show "
+                          "them in a web page)";
         for (const char* f : kNotForStep)
             if (flag == f)
                 return flag + ": not a step option (step records one frame; see step --help)";
@@ -158,10 +169,10 @@ int run(int argc, char** argv) {
     StepScene scene;
     SetupError setup_err;
     if (!setup_scene(req, scene, setup_err)) {
-        std::fprintf(stderr, "step: %s\n", setup_err.message.c_str());
+        std::fprintf(stderr, "step: %s\n", without_outside_hint(setup_err.message).c_str());
         return setup_err.code;
     }
-    for (const std::string& n : scene.notes) std::fprintf(stderr, "step: %s\n", n.c_str());
+    for (const std::string& n : scene.notes) std::fprintf(stderr, "step: %s\n", without_outside_hint(n).c_str());
 
     Recording rec;
     record_frame(scene, rec);

@@ -1,14 +1,31 @@
 // Persistent worker threads; see thread_pool.h.
 #include "raster/thread_pool.h"
 
+#include <system_error>
+
 namespace prast {
 
-ThreadPool::ThreadPool(int threads) {
-    if (threads < 1) threads = 1;
-    for (int i = 1; i < threads; ++i) workers_.emplace_back([this, i] { worker_loop(i); });
+ThreadPool::ThreadPool(int threads) : requested_(threads < 1 ? 1 : threads) {
+    workers_.reserve(std::size_t(requested_ - 1));
+    for (int i = 1; i < requested_; ++i) {
+        try {
+            workers_.emplace_back([this, i] { worker_loop(i); });
+        } catch (const std::system_error& e) {
+            // Keep the threads that started; the caller's thread makes one more.
+            started_fewer_ = "could start only " + std::to_string(i) + " of " + std::to_string(requested_) +
+                             " threads (" + e.code().message() + ")";
+            break;
+        } catch (const std::bad_alloc&) {
+            started_fewer_ = "could start only " + std::to_string(i) + " of " + std::to_string(requested_) +
+                             " threads (out of memory)";
+            break;
+        }
+    }
 }
 
-ThreadPool::~ThreadPool() {
+ThreadPool::~ThreadPool() { shut_down(); }
+
+void ThreadPool::shut_down() {
     {
         std::lock_guard<std::mutex> lock(mutex_);
         stop_ = true;
@@ -27,7 +44,15 @@ void ThreadPool::work(int worker) {
     for (;;) {
         int task = next_.fetch_add(1, std::memory_order_relaxed);
         if (task >= count_) return;
-        (*fn_)(task, worker);
+        try {
+            (*fn_)(task, worker);
+        } catch (...) {
+            std::lock_guard<std::mutex> lock(mutex_);
+            if (!error_) error_ = std::current_exception();
+            // No new task starts; those running finish.
+            next_.store(count_, std::memory_order_relaxed);
+            return;
+        }
     }
 }
 
@@ -43,13 +68,20 @@ void ThreadPool::run(int count, const std::function<void(int, int)>& fn) {
         count_ = count;
         next_.store(0, std::memory_order_relaxed);
         busy_ = int(workers_.size());
+        error_ = nullptr;
         ++generation_;
     }
     start_cv_.notify_all();
     work(0);
-    std::unique_lock<std::mutex> lock(mutex_);
-    done_cv_.wait(lock, [this] { return busy_ == 0; });
-    fn_ = nullptr;
+    std::exception_ptr error;
+    {
+        std::unique_lock<std::mutex> lock(mutex_);
+        done_cv_.wait(lock, [this] { return busy_ == 0; });
+        fn_ = nullptr;
+        error = error_;
+        error_ = nullptr;
+    }
+    if (error) std::rethrow_exception(error);
 }
 
 void ThreadPool::worker_loop(int worker) {

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <thread>
 
 #include <zlib.h>
@@ -98,7 +99,12 @@ PngOptions png_options_threads(int threads) {
             for (int b = next++; b < count; b = next++) fn(b);
         };
         std::vector<std::thread> pool;
-        for (int t = 1; t < std::min(threads, count); ++t) pool.emplace_back(work);
+        // A thread that cannot be started (a process limit) leaves the work
+        // to the others; unwinding past joinable threads would terminate.
+        try {
+            for (int t = 1; t < std::min(threads, count); ++t) pool.emplace_back(work);
+        } catch (const std::system_error&) {
+        }
         work();
         for (std::thread& t : pool) t.join();
     };

@@ -24,6 +24,12 @@
 #include <png.h>
 #include <zlib.h>
 #include <stb_image.h>
+#include <unistd.h>
+
+#include "scene/file_access.h"
+#include "scene/hdr_guard.h"
+#include "scene/jpeg_guard.h"
+#include "scene/messages.h"
 
 namespace prast {
 
@@ -37,6 +43,8 @@ float srgb_to_linear(float c) {
 
 std::string stbi_reason() {
     const char* r = stbi_failure_reason();
+    if (r && std::string(r) == "outofmem") return "out of memory";
+    if (r && std::string(r) == "outofdata") return "truncated image data";
     return r ? r : "unknown error";
 }
 
@@ -54,44 +62,9 @@ const char* sniff_format(const unsigned char* p, std::size_t n) {
     return nullptr;
 }
 
-// Reads a whole file; stb_image's memory API then decodes it. Reading it
-// ourselves lets us tell a directory, an empty file and an unreadable one apart.
-std::vector<unsigned char> read_file(const std::string& path, const std::string& name) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-        throw LoadError(name + ": is a directory, not an image file");
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw LoadError(name + ": cannot open: " + std::strerror(errno));
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> closer(f, std::fclose);
-    std::vector<unsigned char> bytes;
-    // One read of the whole file when its size is known (no regrowing).
-    if (std::fseek(f, 0, SEEK_END) == 0) {
-        const long size = std::ftell(f);
-        if (size > long(INT_MAX)) throw LoadError(name + ": file too large (over 2 GiB)");
-        if (size > 0) bytes.reserve(std::size_t(size) + 1);
-        std::rewind(f);
-    }
-    unsigned char chunk[1 << 16];
-    for (;;) {
-        if (bytes.capacity() > bytes.size() + 1) {
-            // Straight into the reserved space.
-            const std::size_t old = bytes.size(), room = bytes.capacity() - old;
-            bytes.resize(bytes.capacity());
-            const std::size_t n = std::fread(bytes.data() + old, 1, room, f);
-            bytes.resize(old + n);
-            if (n < room) break;
-            continue;
-        }
-        const std::size_t n = std::fread(chunk, 1, sizeof chunk, f);
-        bytes.insert(bytes.end(), chunk, chunk + n);
-        // stb_image's memory API takes an int length.
-        if (bytes.size() > std::size_t(INT_MAX))
-            throw LoadError(name + ": file too large (over 2 GiB)");
-        if (n < sizeof chunk) break;
-    }
-    if (std::ferror(f)) throw LoadError(name + ": read error: " + std::strerror(errno));
-    if (bytes.empty()) throw LoadError(name + ": empty file");
-    return bytes;
+bool is_png(const unsigned char* p, std::size_t n) {
+    const char* format = sniff_format(p, n);
+    return format && std::strcmp(format, "PNG") == 0;
 }
 
 // Expands `comp` channels per texel to RGBA, decoding colour channels with
@@ -415,21 +388,84 @@ const float* unorm8_decode_table() {
     return table.data();
 }
 
+namespace {
+
+// Twice the densest JPEG possible (512 texels a byte, see decode_image).
+constexpr std::int64_t kMaxJpegTexelsPerByte = 1024;
+
+// Deflate's densest output: a 258-byte match costs at least 2 bits (a
+// length and a distance code), so 1032 bytes per compressed byte.
+constexpr std::int64_t kMaxDeflateRatio = 1032;
+
+// "" when every chunk of a PNG lies within the file and its IDAT chunks can
+// hold the pixels its header claims; else why not. Checked before any decoder allocates the image: a 100-byte file
+// claiming 16384x16384 texels would otherwise cost a gigabyte of zeroed
+// memory before failing as truncated. The filtered rows hold at least
+// w * h * bits / 8 bytes (interlaced or not), and no more than
+// kMaxDeflateRatio bytes come from each compressed one.
+std::string png_data_shortfall(const unsigned char* data, std::size_t size, int w, int h) {
+    if (size < 8 + 25) return "";  // the decoders name a short file
+    const unsigned char* ihdr = data + 16;
+    static const int kSamples[7] = {1, 0, 3, 1, 2, 0, 4};
+    const int depth = ihdr[8], colour = ihdr[9];
+    if (colour > 6 || !kSamples[colour] || depth < 1 || depth > 16) return "";  // refused by the decoders
+    const std::int64_t bits = std::int64_t(kSamples[colour]) * depth;
+    const std::int64_t need = std::int64_t(w) * std::int64_t(h) * bits / 8;
+    std::int64_t idat = 0;
+    for (std::size_t pos = 8; pos + 12 <= size;) {
+        const std::uint32_t len = be32(data + pos);
+        const std::string type = printable(std::string(reinterpret_cast<const char*>(data + pos + 4), 4));
+        // A chunk past the end of the file: stb_image 2.27 grows its buffer
+        // to the claimed length first (up to 4 GiB for one 16-bit file).
+        if (len > size - pos - 12)
+            return "truncated: the " + type + " chunk at byte " + std::to_string(pos) + " claims " +
+                   std::to_string(len) + " bytes, " + std::to_string(size - pos - 12) + " are left";
+        if (type == "IDAT") idat += len;
+        if (type == "IEND") break;
+        pos += 12 + std::size_t(len);
+    }
+    if (need <= kMaxDeflateRatio * idat + 1024) return "";
+    return std::to_string(w) + "x" + std::to_string(h) + " texels need at least " + std::to_string(need) +
+           " bytes of pixel data, and " + std::to_string(idat) + " compressed bytes hold at most " +
+           std::to_string(kMaxDeflateRatio * idat + 1024);
+}
+
+// "" when stb_image 2.27 may see these bytes; else "cannot decode FORMAT
+// image: why".
+std::string stb_unsafe(const unsigned char* data, std::size_t size) {
+    std::string why;
+    if (looks_like_hdr(data, size)) {
+        int w = 0, h = 0;
+        why = check_hdr_data(data, size, w, h);
+        return why.empty() ? why : "cannot decode HDR image: " + why;
+    }
+    why = check_jpeg_data(data, size);
+    return why.empty() ? why : "cannot decode JPEG image: " + why;
+}
+
+} // namespace
+
 Image decode_image(const ImageSource& src, bool srgb) {
-    const std::string name = !src.name.empty()   ? src.name
-                             : !src.path.empty() ? src.path
-                                                 : std::string("<embedded image>");
+    const std::string name = printable(!src.name.empty()   ? src.name
+                                       : !src.path.empty() ? src.path
+                                                           : std::string("<embedded image>"));
     // Get the encoded bytes: embedded ones win over the path.
     std::vector<unsigned char> file_bytes;
     const std::vector<unsigned char>* bytes = &src.bytes;
     if (src.bytes.empty()) {
         if (src.path.empty()) throw LoadError(name + ": no image data (no path, no bytes)");
-        file_bytes = read_file(src.path, name);
+        // Only a regular file, never past what stb_image's int length takes.
+        file_bytes = read_regular_file(src.path, std::uint64_t(INT_MAX), name);
         bytes = &file_bytes;
     }
     if (bytes->size() > std::size_t(INT_MAX)) throw LoadError(name + ": image data too large");
     const stbi_uc* data = bytes->data();
     const int len = int(bytes->size());
+
+    // Through the guards first: stb_image 2.27 can hang on Radiance data and
+    // write out of bounds on JPEG data (scene/hdr_guard.h, scene/jpeg_guard.h).
+    const std::string unsafe = stb_unsafe(data, bytes->size());
+    if (!unsafe.empty()) throw LoadError(name + ": " + unsafe);
 
     // Check the header before decoding anything: refuse absurd sizes up front.
     int w = 0, h = 0, comp = 0;
@@ -449,6 +485,18 @@ Image decode_image(const ImageSource& src, bool srgb) {
                         std::to_string(h) + " = " + std::to_string(texels) +
                         " texels, more than the limit of " + std::to_string(kMaxImageTexels) +
                         " (2^28)");
+    // A JPEG needs at least a bit per 8x8 block (a progressive DC scan), so
+    // no file holds more than 512 texels a byte; a small file that claims
+    // more would keep stb_image decoding made-up data for seconds.
+    if (looks_like_jpeg(data, bytes->size()) && texels > kMaxJpegTexelsPerByte * std::int64_t(bytes->size()))
+        throw LoadError(name + ": cannot decode JPEG image: " + std::to_string(w) + "x" + std::to_string(h) +
+                        " texels from only " + std::to_string(bytes->size()) + " bytes (a JPEG holds at most " +
+                        std::to_string(kMaxJpegTexelsPerByte) + " texels a byte)");
+
+    if (is_png(data, bytes->size())) {
+        const std::string shortfall = png_data_shortfall(data, bytes->size(), w, h);
+        if (!shortfall.empty()) throw LoadError(name + ": cannot decode PNG image: " + shortfall);
+    }
 
     // Decode with the file's own channel count.
     struct StbiFree {
@@ -457,7 +505,11 @@ Image decode_image(const ImageSource& src, bool srgb) {
     Image img;
     int dw = 0, dh = 0, dcomp = 0;
     auto check = [&](const void* pixels) {
-        if (!pixels) throw LoadError(name + ": cannot decode image: " + stbi_reason());
+        if (!pixels) {
+            const char* format = sniff_format(data, bytes->size());
+            throw LoadError(name + ": cannot decode " + (format ? format : "") + (format ? " " : "") +
+                            "image: " + stbi_reason());
+        }
         if (dw != w || dh != h || dcomp < 1 || dcomp > 4)
             throw LoadError(name + ": inconsistent image header");
         img.width = w;
@@ -479,7 +531,7 @@ Image decode_image(const ImageSource& src, bool srgb) {
         const auto decode = [](stbi_us c) { return srgb_to_linear(float(c) / 65535.0f); };
         if (srgb) expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), decode, linear);
         else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
-    } else if (sniff_format(data, bytes->size()) == std::string("PNG")) {
+    } else if (is_png(data, bytes->size())) {
         // 8-bit PNG: the bytes as the file has them; sampling decodes them.
         std::string error;
         const FastPng fast = decode_png_fast(data, bytes->size(), w, h, img, error);
@@ -499,6 +551,47 @@ Image decode_image(const ImageSource& src, bool srgb) {
         img.pixels.assign(px.get(), px.get() + count * std::size_t(dcomp));
     }
     return img;
+}
+
+bool image_dimensions(const ImageSource& src, int& width, int& height, int* bytes_per_texel) {
+    width = height = 0;
+    // The header is within the first MiB of any file the project reads (a
+    // JPEG's frame header follows its EXIF and ICC segments, 64 KiB each).
+    constexpr std::size_t kHeaderBytes = std::size_t(1) << 20;
+    std::vector<unsigned char> head;
+    const std::vector<unsigned char>* bytes = &src.bytes;
+    if (src.bytes.empty()) {
+        if (src.path.empty()) return false;
+        std::uint64_t size = 0;
+        int fd = -1;
+        try {
+            fd = open_regular_file(src.path, src.name, size);
+        } catch (const LoadError&) {
+            return false;
+        }
+        head.resize(std::size_t(std::min<std::uint64_t>(size, kHeaderBytes)));
+        std::size_t got = 0;
+        while (got < head.size()) {
+            const ssize_t n = ::read(fd, head.data() + got, head.size() - got);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) break;
+            got += std::size_t(n);
+        }
+        ::close(fd);
+        head.resize(got);
+        bytes = &head;
+    }
+    if (bytes->empty() || bytes->size() > std::size_t(INT_MAX)) return false;
+    const stbi_uc* data = bytes->data();
+    const int len = int(bytes->size());
+    // stbi_info reads a JPEG's tables (guarded); a Radiance header alone is
+    // safe, and its pixels are beyond the prefix read here.
+    if (!looks_like_hdr(data, bytes->size()) && !stb_unsafe(data, bytes->size()).empty()) return false;
+    int comp = 0;
+    if (!stbi_info_from_memory(data, len, &width, &height, &comp)) return false;
+    if (bytes_per_texel)
+        *bytes_per_texel = stbi_is_hdr_from_memory(data, len) || stbi_is_16_bit_from_memory(data, len) ? 16 : comp;
+    return true;
 }
 
 } // namespace prast

@@ -77,4 +77,11 @@ constexpr std::int64_t kMaxImageTexels = std::int64_t(1) << 28;
 // or oversized image.
 Image decode_image(const ImageSource& src, bool srgb);
 
+// The width and height in an image's header, read without decoding (a file
+// only as far as its header, through scene/file_access.h), and the bytes a
+// decoded texel takes (the channel count for 8-bit files, 16 for float RGBA:
+// HDR and 16-bit); false when the header cannot be read. For planning memory
+// before decoding.
+bool image_dimensions(const ImageSource& src, int& width, int& height, int* bytes_per_texel = nullptr);
+
 } // namespace prast

@@ -2,15 +2,14 @@
 #include "scene/image_diff.h"
 
 #include <algorithm>
-#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
-#include <stb_image.h>
 
+#include "scene/hdr_guard.h"
 #include "scene/image.h"
 #include "scene/load_scene.h"
 
@@ -42,30 +41,37 @@ Image8 Image8::from_rgba(int width, int height, const std::uint8_t* rgba, bool h
 }
 
 Image8 read_image8(const std::string& path) {
-    const std::vector<unsigned char> bytes = detail::read_file(path);
-    if (bytes.size() > std::size_t(INT_MAX)) throw LoadError(path + ": image file too large");
-    const int len = int(bytes.size());
-    int w = 0, h = 0, comp = 0;
-    if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &comp)) {
-        const char* reason = stbi_failure_reason();
-        throw LoadError(path + ": not an image stb_image can read (" +
-                        (reason ? std::string(reason) : std::string("unknown error")) + ")");
-    }
-    if (stbi_is_hdr_from_memory(bytes.data(), len))
+    // Through the renderer's decoder (scene/image.h): the same file checks,
+    // header limits and guards in front of stb_image, so an image from a
+    // stranger is as safe to compare as to render.
+    ImageSource src;
+    src.name = path;
+    src.bytes = detail::read_file(path);
+    if (src.bytes.empty()) throw LoadError(path + ": empty file");
+    if (looks_like_hdr(src.bytes.data(), src.bytes.size()))
         throw LoadError(path + ": is a Radiance HDR image; only 8-bit images (PNG, ...) can be compared");
-    if (w <= 0 || h <= 0 || std::int64_t(w) * h > kMaxImageTexels)
-        throw LoadError(path + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h));
-    int dw = 0, dh = 0, dcomp = 0;
-    stbi_uc* data = stbi_load_from_memory(bytes.data(), len, &dw, &dh, &dcomp, 4);
-    if (!data) {
-        const char* reason = stbi_failure_reason();
-        throw LoadError(path + ": cannot decode image (" +
-                        (reason ? std::string(reason) : std::string("unknown error")) + ")");
+    const Image img = decode_image(src, false);
+    const std::size_t n = img.texel_count();
+    std::vector<std::uint8_t> rgba(n * 4);
+    bool has_alpha = img.channels == 2 || img.channels == 4;
+    if (img.is_8bit()) {
+        const int c = img.channels;
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::uint8_t* p = &img.pixels[i * std::size_t(c)];
+            std::uint8_t* q = &rgba[i * 4];
+            q[0] = p[0];
+            q[1] = c >= 3 ? p[1] : p[0];
+            q[2] = c >= 3 ? p[2] : p[0];
+            q[3] = c == 2 ? p[1] : (c == 4 ? p[3] : 255);
+        }
+    } else {
+        // 16-bit files, as linear v / 65535: back to v, then its high byte
+        // (what stb_image's 8-bit load gives).
+        for (std::size_t i = 0; i < n * 4; ++i)
+            rgba[i] = std::uint8_t(long(std::lround(double(img.rgba[i]) * 65535.0)) >> 8);
+        for (std::size_t i = 3; i < n * 4 && !has_alpha; i += 4) has_alpha = rgba[i] != 255;
     }
-    // Grey + alpha (2) and RGBA (4) carry alpha.
-    Image8 img = Image8::from_rgba(dw, dh, data, dcomp == 2 || dcomp == 4);
-    stbi_image_free(data);
-    return img;
+    return Image8::from_rgba(img.width, img.height, rgba.data(), has_alpha);
 }
 
 DiffResult diff_images(const Image8& a, const Image8& b, const DiffTolerance& tol) {

@@ -10,7 +10,11 @@
 //  - an image in a bufferView is handed to the image callback without checking
 //    byteOffset/byteLength against the buffer: the callback ignores those bytes
 //    and they are copied here after a bounds check.
-// Images are never decoded here (tinygltf is built without stb_image).
+// Images are never decoded here (tinygltf is built without stb_image), and
+// tinygltf never opens an image file (TINYGLTF_NO_EXTERNAL_IMAGE): image uris
+// are resolved here, buffer uris through file-system callbacks, both by the
+// model's FileScope (scene/file_access.h), so no uri leaves the model's folder
+// or opens a FIFO, and none is looked up in the current directory.
 #include "scene/load_scene.h"
 
 #include <algorithm>
@@ -18,8 +22,10 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <map>
+#include <new>
 #include <set>
+#include <stdexcept>
 #include <type_traits>
 #include <utility>
 
@@ -31,6 +37,9 @@
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE_WRITE
 #include <tiny_gltf.h>
+
+#include "scene/file_access.h"
+#include "scene/messages.h"
 
 namespace prast {
 
@@ -57,25 +66,51 @@ bool keep_encoded_image(tinygltf::Image* image, const int /*image_idx*/, std::st
     return true;
 }
 
-// tinygltf's reader, bounded: only regular files (a FIFO or device named by a
-// URI would block), at most kMaxFileBytes.
-bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path,
-                     void* /*user*/) {
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) {
-        if (err) *err += "not a regular file: " + path;
+// tinygltf's file system, confined: tinygltf asks FileExists for
+// JoinPath(base_dir, uri) and then for "./uri" (the current directory);
+// only the first is answered, through the model's FileScope, before anything
+// is opened, and ReadWholeFile reads what that resolved to.
+struct ScopedFs {
+    FileScope* scope = nullptr;
+    std::string refused;                          // the first refusal, a whole message
+    std::map<std::string, std::string> resolved;  // asked path -> canonical path
+};
+
+bool scoped_file_exists(const std::string& path, void* user) {
+    ScopedFs& fs_state = *static_cast<ScopedFs*>(user);
+    FileScope& scope = *fs_state.scope;
+    const std::string prefix = scope.root() == "/" ? "/" : scope.root() + "/";
+    if (path.compare(0, prefix.size(), prefix) != 0) return false;  // the current-directory look-up
+    const std::string uri = path.substr(prefix.size());
+    const FileScope::Resolved where = scope.resolve(scope.root(), uri);
+    if (where.ok()) {
+        fs_state.resolved[path] = where.path;
+        return true;
+    }
+    if (!where.missing && fs_state.refused.empty()) fs_state.refused = scope.refusal("buffer uri", uri, where);
+    return false;
+}
+
+std::string keep_path(const std::string& path, void*) { return path; }
+
+bool scoped_read_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+    ScopedFs& fs_state = *static_cast<ScopedFs*>(user);
+    const auto it = fs_state.resolved.find(path);
+    if (it == fs_state.resolved.end()) {
+        if (err) *err += "not resolved: " + path;
         return false;
     }
-    const std::uintmax_t size = fs::file_size(path, ec);
-    if (ec || size > detail::kMaxFileBytes) {
-        if (err) *err += "cannot read or too large: " + path;
-        return false;
-    }
-    std::ifstream in(path, std::ios::binary);
-    out->resize(std::size_t(size));
-    in.read(reinterpret_cast<char*>(out->data()), std::streamsize(out->size()));
-    if (!in && !out->empty()) {
-        if (err) *err += "read error: " + path;
+    try {
+        *out = read_regular_file(it->second, detail::kMaxFileBytes);
+        std::string why;
+        if (!fs_state.scope->charge(out->size(), why)) {
+            out->clear();
+            if (fs_state.refused.empty()) fs_state.refused = printable(fs_state.scope->model()) + ": " + why;
+            if (err) *err += why;
+            return false;
+        }
+    } catch (const LoadError& e) {
+        if (err) *err += e.what();
         return false;
     }
     return true;
@@ -234,7 +269,8 @@ Wrap wrap_mode(int mode, bool& known) {
 
 class GltfLoader {
 public:
-    explicit GltfLoader(const std::string& path) : path_(path) {}
+    GltfLoader(const std::string& path, const LoadOptions& options)
+        : path_(path), shown_(printable(path)), scope_(path, options.allow_outside_paths) {}
 
     Scene load() {
         parse();
@@ -243,6 +279,7 @@ public:
         for (std::size_t i = 0; i < model_.materials.size(); ++i)
             scene_.materials.push_back(convert_material(model_.materials[i], i));
         traverse_scene();
+        scene_.warnings = log_.lines();
         detail::finish_scene(scene_, path_);
         return std::move(scene_);
     }
@@ -250,8 +287,9 @@ public:
 private:
     static constexpr int kNotYet = -2;
 
-    [[noreturn]] void fail(const std::string& why) const { throw LoadError(path_ + ": " + why); }
-    void warn(const std::string& what) { scene_.warnings.push_back(path_ + ": " + what); }
+    // Messages hold names from the file: escaped here, once for all.
+    [[noreturn]] void fail(const std::string& why) const { throw LoadError(shown_ + ": " + printable(why)); }
+    void warn(const std::string& what) { log_.add(shown_ + ": " + printable(what)); }
     void warn_once(const std::string& what) {
         if (warned_.insert(what).second) warn(what);
     }
@@ -266,28 +304,31 @@ private:
 
         tinygltf::TinyGLTF ctx;
         ctx.SetImageLoader(&keep_encoded_image, nullptr);
+        ScopedFs fs_state;
+        fs_state.scope = &scope_;
         tinygltf::FsCallbacks callbacks;
-        callbacks.FileExists = &tinygltf::FileExists;
-        callbacks.ExpandFilePath = &tinygltf::ExpandFilePath;
-        callbacks.ReadWholeFile = &read_whole_file;
+        callbacks.FileExists = &scoped_file_exists;
+        callbacks.ExpandFilePath = &keep_path;
+        callbacks.ReadWholeFile = &scoped_read_file;
         callbacks.WriteWholeFile = &refuse_write;
-        callbacks.user_data = nullptr;
+        callbacks.user_data = &fs_state;
         ctx.SetFsCallbacks(callbacks);
 
-        base_dir_ = fs::path(path_).parent_path().string();
+        base_dir_ = scope_.root();
         std::string err, warnings;
         bool ok = false;
         if (glb) {
-            const std::size_t length = check_glb(bytes, path_);
-            check_json_depth(reinterpret_cast<const char*>(&bytes[20]), le32(&bytes[12]), path_);
+            const std::size_t length = check_glb(bytes, shown_);
+            check_json_depth(reinterpret_cast<const char*>(&bytes[20]), le32(&bytes[12]), shown_);
             ok = ctx.LoadBinaryFromMemory(&model_, &err, &warnings, bytes.data(),
                                           static_cast<unsigned int>(length), base_dir_);
         } else {
-            check_json_depth(reinterpret_cast<const char*>(bytes.data()), bytes.size(), path_);
+            check_json_depth(reinterpret_cast<const char*>(bytes.data()), bytes.size(), shown_);
             ok = ctx.LoadASCIIFromString(&model_, &err, &warnings,
                                          reinterpret_cast<const char*>(bytes.data()),
                                          static_cast<unsigned int>(bytes.size()), base_dir_);
         }
+        if (!ok && !fs_state.refused.empty()) throw LoadError(fs_state.refused);
         if (!ok) fail(first_line(err, "cannot parse glTF"));
 
         // tinygltf's warnings, except the missing images that image_for() reports.
@@ -347,7 +388,7 @@ private:
     // Accessor `index` as count * components values of T; `type` is the
     // required glTF type (TINYGLTF_TYPE_VEC3, ...). Sparse accessors included.
     template <class T>
-    std::vector<T> read_accessor(int index, int type, const std::string& context) const {
+    std::vector<T> read_accessor(int index, int type, const std::string& context) {
         const std::string what = context + ": accessor " + std::to_string(index);
         if (index < 0 || std::size_t(index) >= model_.accessors.size())
             fail(context + ": accessor " + std::to_string(index) + " out of range (" +
@@ -358,6 +399,15 @@ private:
         if (a.type != type || ncomp == 0) fail(what + ": wrong type");
         if (csize == 0) fail(what + ": unsupported componentType " + std::to_string(a.componentType));
         if (a.count > kMaxAccessorCount) fail(what + ": absurd count " + std::to_string(a.count));
+        // Budgets first, before anything is allocated or looped over.
+        if (a.bufferView < 0) {
+            zero_filled_ += a.count;
+            if (zero_filled_ > detail::kMaxZeroFilledElements)
+                fail(what + ": " + std::to_string(a.count) + " elements without a bufferView bring the zero-filled "
+                     "elements to " + std::to_string(zero_filled_) + ", more than the limit of " +
+                     std::to_string(detail::kMaxZeroFilledElements) + " (2^22)");
+        }
+        charge(a.count, what);
         const std::size_t elem = csize * std::size_t(ncomp);
         // `normalized` means nothing for indices.
         const bool normalized = a.normalized && std::is_floating_point_v<T>;
@@ -375,7 +425,6 @@ private:
                                     normalized));
         } else {
             // No bufferView: zeros (glTF 2.0), which only sparse values may replace.
-            if (a.count > detail::kMaxSceneElements) fail(what + ": absurd count without data");
             out.assign(a.count * std::size_t(ncomp), T(0));
         }
 
@@ -438,14 +487,21 @@ private:
                 return -1;
             }
         } else if (!img.uri.empty()) {
-            const fs::path file = fs::path(base_dir_) / decode_uri(img.uri);
-            std::error_code ec;
-            if (!fs::is_regular_file(file, ec)) {
-                warn("image " + std::to_string(i) + " '" + img.uri + "' not found, texture ignored");
+            const FileScope::Resolved where = scope_.resolve(scope_.root(), decode_uri(img.uri));
+            if (!where.ok()) {
+                if (where.missing) warn("image " + std::to_string(i) + " '" + img.uri + "' not found, texture ignored");
+                else log_.add(scope_.refusal("image " + std::to_string(i), img.uri, where) + ", texture ignored");
                 return -1;
             }
-            src.path = file.lexically_normal().string();
+            // One Scene image per file, however many images or spellings name it.
+            const auto known = image_by_path_.find(where.path);
+            if (known != image_by_path_.end()) return mapped = known->second;
+            src.path = where.path;
             src.name = src.path;
+            scene_.images.push_back(std::move(src));
+            mapped = int(scene_.images.size()) - 1;
+            image_by_path_.emplace(where.path, mapped);
+            return mapped;
         } else if (!img.image.empty()) {
             src.bytes = img.image; // data URI
         } else {
@@ -717,7 +773,6 @@ private:
         const std::vector<float> pos = read_accessor<float>(position, TINYGLTF_TYPE_VEC3, what + " POSITION");
         const std::size_t n = pos.size() / 3;
         if (n == 0) return false;
-        budget(n);
         std::vector<float> nrm, uv, tan;
         const int normal = attribute("NORMAL"), texcoord = attribute("TEXCOORD_0"),
                   tangent = attribute("TANGENT");
@@ -757,7 +812,6 @@ private:
             warn(what + ": index count " + std::to_string(indices.size()) + " not a multiple of 3, truncated");
             indices.resize(indices.size() / 3 * 3);
         }
-        budget(indices.size());
         if (indices.empty()) return false;
 
         // Transform to world space. A mirroring transform (negative determinant)
@@ -791,12 +845,15 @@ private:
         return true;
     }
 
-    // Keeps the flattened scene (meshes instanced by many nodes are copied)
-    // within kMaxSceneElements vertices and as many indices.
-    void budget(std::size_t elements) {
+    // Keeps what the flattened scene reads (meshes instanced by many nodes
+    // are read once per instance) within kMaxSceneElements accessor elements,
+    // checked before each accessor is allocated.
+    void charge(std::size_t elements, const std::string& what) {
         elements_ += elements;
-        if (elements_ > 2 * detail::kMaxSceneElements)
-            fail("scene too large (over " + std::to_string(detail::kMaxSceneElements) + " vertices/indices)");
+        if (elements_ > detail::kMaxSceneElements)
+            fail(what + ": " + std::to_string(elements) + " elements bring the scene to " + std::to_string(elements_) +
+                 " accessor elements, more than the limit of " + std::to_string(detail::kMaxSceneElements) +
+                 " (2^27)");
     }
 
     // ---- Lights (KHR_lights_punctual)
@@ -847,25 +904,34 @@ private:
     }
 
     const std::string& path_;
+    const std::string shown_;  // path_, printable
+    FileScope scope_;
+    WarningLog log_;
     std::string base_dir_;
     tinygltf::Model model_;
     Scene scene_;
     std::vector<int> image_map_; // glTF image -> Scene image, kNotYet or -1
     std::vector<int> parentless_;
     std::set<std::string> warned_;
-    std::size_t elements_ = 0;
+    std::size_t elements_ = 0;     // accessor elements read
+    std::size_t zero_filled_ = 0;  // of which made up (no bufferView)
+    std::map<std::string, int> image_by_path_;
 };
 
 } // namespace
 
-Scene load_gltf(const std::string& path) {
+Scene load_gltf(const std::string& path, const LoadOptions& options) {
     try {
-        return GltfLoader(path).load();
+        return GltfLoader(path, options).load();
     } catch (const LoadError&) {
         throw;
+    } catch (const std::bad_alloc&) {
+        throw LoadError(printable(path) + ": out of memory while loading the model");
+    } catch (const std::length_error&) {
+        throw LoadError(printable(path) + ": too large to load (a size exceeds what memory can hold)");
     } catch (const std::exception& e) {
-        // tinygltf and nlohmann::json may throw (out_of_range, bad_alloc, ...).
-        throw LoadError(path + ": " + e.what());
+        // tinygltf and nlohmann::json may throw (out_of_range, type_error, ...).
+        throw LoadError(printable(path) + ": cannot load: " + printable(e.what()));
     }
 }
 

@@ -16,13 +16,17 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <new>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <unordered_map>
 #include <utility>
 
 #include <tiny_obj_loader.h>
 
+#include "scene/file_access.h"
+#include "scene/messages.h"
 #include "scene/tangents.h"
 
 namespace prast {
@@ -39,7 +43,7 @@ constexpr std::size_t kMaxFaceVertices = 256;
 struct MtlKeys {
     bool kd = false, pr = false, pm = false, ke = false;
     std::string conductor; // value of `Pc` when it is a word
-    fs::path dir;          // texture paths are relative to the MTL's folder
+    std::string dir;       // texture paths are relative to the MTL's (canonical) folder
 };
 
 // Lines as tinyobjloader's safeGetline splits them: at \n, \r\n or \r.
@@ -81,23 +85,34 @@ std::string lower(std::string s) {
     return s;
 }
 
-// Reads each `mtllib` file for tinyobjloader (see the file comment).
+// Reads each `mtllib` file for tinyobjloader (see the file comment), through
+// the model's FileScope; each file once, however it is spelled.
 class MtlReader : public tinyobj::MaterialReader {
 public:
-    MtlReader(const std::string& obj_path, std::vector<MtlKeys>& keys,
-              std::vector<std::string>& warnings)
-        : obj_path_(obj_path), keys_(keys), warnings_(warnings) {}
+    MtlReader(FileScope& scope, std::vector<MtlKeys>& keys, WarningLog& warnings)
+        : scope_(scope), keys_(keys), warnings_(warnings) {}
 
     bool operator()(const std::string& mat_id, std::vector<tinyobj::material_t>* materials,
                     std::map<std::string, int>* mat_map, std::string* warn,
                     std::string* /*err*/) override {
-        const fs::path mtl_path = fs::path(obj_path_).parent_path() / mat_id;
+        const std::string shown = printable(scope_.model());
+        const FileScope::Resolved where = scope_.resolve(scope_.root(), mat_id);
+        if (!where.ok()) {
+            if (where.missing)
+                warnings_.add(shown + ": material library '" + printable(mat_id) +
+                              "' not found; default material used");
+            else warnings_.add(scope_.refusal("material library", mat_id, where) + "; default material used");
+            return false;
+        }
+        // Already read under another spelling: its materials are there.
+        if (!loaded_.insert(where.path).second) return true;
         std::vector<unsigned char> bytes;
         try {
-            bytes = detail::read_file(mtl_path.string());
+            bytes = read_regular_file(where.path, detail::kMaxFileBytes, mat_id);
+            std::string why;
+            if (!scope_.charge(bytes.size(), why)) throw LoadError(printable(mat_id) + ": " + why);
         } catch (const LoadError& e) {
-            warnings_.push_back(obj_path_ + ": material library " + e.what() +
-                                "; default material used");
+            warnings_.add(shown + ": material library " + e.what() + "; default material used");
             return false;
         }
         const std::string text(bytes.begin(), bytes.end());
@@ -126,7 +141,7 @@ public:
                 flush();
                 block.clear();
                 keys = MtlKeys();
-                keys.dir = mtl_path.parent_path();
+                keys.dir = folder_of(where.path);
                 in_block = true;
             }
             block += raw;
@@ -148,9 +163,10 @@ public:
     }
 
 private:
-    const std::string& obj_path_;
+    FileScope& scope_;
     std::vector<MtlKeys>& keys_;
-    std::vector<std::string>& warnings_;
+    WarningLog& warnings_;
+    std::set<std::string> loaded_;  // canonical paths of the libraries read
 };
 
 // Rejects what would make tinyobjloader slow: polygons with very many corners.
@@ -162,7 +178,7 @@ void prevalidate(const std::string& text, const std::string& path) {
         for (std::size_t i = 1; i < line.size(); ++i)
             if (!is_space(line[i]) && is_space(line[i - 1])) ++corners;
         if (corners > kMaxFaceVertices)
-            throw LoadError(path + ": a face has " + std::to_string(corners) +
+            throw LoadError(printable(path) + ": a face has " + std::to_string(corners) +
                             " vertices (at most " + std::to_string(kMaxFaceVertices) +
                             " supported)");
     }
@@ -192,7 +208,8 @@ struct MeshBuilder {
 
 class ObjLoader {
 public:
-    explicit ObjLoader(const std::string& path) : path_(path) {}
+    ObjLoader(const std::string& path, const LoadOptions& options)
+        : path_(path), shown_(printable(path)), scope_(path, options.allow_outside_paths) {}
 
     Scene load() {
         const std::vector<unsigned char> bytes = detail::read_file(path_);
@@ -204,13 +221,13 @@ public:
         std::vector<tinyobj::shape_t> shapes;
         std::vector<tinyobj::material_t> materials;
         std::string warn, err;
-        MtlReader reader(path_, keys_, scene_.warnings);
+        MtlReader reader(scope_, keys_, log_);
         std::istringstream in(text);
         const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &in, &reader,
                                          /*triangulate=*/true, /*default_vcols_fallback=*/false);
-        if (!ok) throw LoadError(path_ + ": " + first_line(err, "cannot parse OBJ"));
+        if (!ok) throw LoadError(shown_ + ": " + printable(first_line(err, "cannot parse OBJ")));
         if (keys_.size() != materials.size()) // cannot happen: only MtlReader adds materials
-            throw LoadError(path_ + ": internal error reading materials");
+            throw LoadError(shown_ + ": internal error reading materials");
 
         for (std::size_t i = 0; i < materials.size(); ++i)
             scene_.materials.push_back(convert_material(materials[i], keys_[i]));
@@ -218,8 +235,9 @@ public:
         // tinyobjloader silently drops quads and polygons with a bad index.
         if (warn.find("out of bounds") != std::string::npos ||
             warn.find("invalid vertex index") != std::string::npos)
-            throw LoadError(path_ + ": face index out of range");
+            throw LoadError(shown_ + ": face index out of range");
         pass_on_warnings(warn);
+        scene_.warnings = log_.lines();
         detail::finish_scene(scene_, path_);
         return std::move(scene_);
     }
@@ -242,30 +260,25 @@ private:
             if (line.rfind("Material file [", 0) == 0 || line.rfind("Failed to load material", 0) == 0)
                 continue; // MtlReader reported it
             if (seen.size() > 8) { ++extra; continue; }
-            scene_.warnings.push_back(path_ + ": " + line);
+            log_.add(shown_ + ": " + printable(line));
         }
-        if (extra > 0)
-            scene_.warnings.push_back(path_ + ": " + std::to_string(extra) + " more parser warnings");
+        if (extra > 0) log_.add(shown_ + ": " + std::to_string(extra) + " more parser warnings");
     }
 
-    // The Scene image for a map, or -1 (with a warning) when the file is missing.
+    // The Scene image for a map, or -1 (with a warning) when the file is
+    // missing or refused (file_access.h); one image per file however spelled.
     int image_for(const std::string& texname, const MtlKeys& keys, const char* key,
                   const std::string& material) {
         if (texname.empty()) return -1;
-        fs::path p = keys.dir / fs::path(texname);
-        std::error_code ec;
-        if (!fs::is_regular_file(p, ec) && texname.find('\\') != std::string::npos) {
-            // Windows exporters write backslashes.
-            std::string fixed = texname;
-            for (char& c : fixed) if (c == '\\') c = '/';
-            p = keys.dir / fs::path(fixed);
-        }
-        if (!fs::is_regular_file(p, ec)) {
-            scene_.warnings.push_back(path_ + ": material '" + material + "': " + key + " '" +
-                                      texname + "' not found, ignored");
+        const FileScope::Resolved where = scope_.resolve(keys.dir, texname);
+        if (!where.ok()) {
+            const std::string what = "material '" + material + "': " + key;
+            if (where.missing)
+                log_.add(shown_ + ": " + printable(what) + " '" + printable(texname) + "' not found, ignored");
+            else log_.add(scope_.refusal(what, texname, where) + ", ignored");
             return -1;
         }
-        const std::string normal = p.lexically_normal().string();
+        const std::string& normal = where.path;
         const auto it = image_index_.find(normal);
         if (it != image_index_.end()) return it->second;
         ImageSource src;
@@ -328,8 +341,8 @@ private:
             else if (c == "aluminium" || c == "aluminum") m.conductor = Conductor::Aluminium;
             else if (c == "silver") m.conductor = Conductor::Silver;
             else
-                scene_.warnings.push_back(path_ + ": material '" + name + "': unknown conductor 'Pc " +
-                                          c + "' ignored");
+                log_.add(shown_ + ": material '" + printable(name) + "': unknown conductor 'Pc " + printable(c) +
+                         "' ignored");
         }
         // Dissolve (`d`, or 1 - `Tr` as tinyobjloader reads it): glTF's BLEND
         // with the base colour's alpha (README "Transparency").
@@ -339,7 +352,7 @@ private:
             m.base_color_factor.a = float(std::max(0.0, dissolve));
         }
         if (!src.alpha_texname.empty())
-            scene_.warnings.push_back(path_ + ": material '" + name + "': map_d ignored (d / Tr are used)");
+            log_.add(shown_ + ": material '" + printable(name) + "': map_d ignored (d / Tr are used)");
         return m;
     }
 
@@ -370,16 +383,16 @@ private:
         std::size_t total = 0;
         for (const tinyobj::shape_t& shape : shapes) {
             const auto& idx = shape.mesh.indices;
-            if (idx.size() % 3 != 0) throw LoadError(path_ + ": bad face (not a triangle)");
+            if (idx.size() % 3 != 0) throw LoadError(shown_ + ": bad face (not a triangle)");
             for (const tinyobj::index_t& c : idx) {
                 if (c.vertex_index < 0 || c.vertex_index >= nv)
-                    throw LoadError(path_ + ": face vertex index " + std::to_string(c.vertex_index + 1) +
+                    throw LoadError(shown_ + ": face vertex index " + std::to_string(c.vertex_index + 1) +
                                     " out of range (" + std::to_string(nv) + " vertices)");
                 if (c.normal_index < -1 || c.normal_index >= nn)
-                    throw LoadError(path_ + ": face normal index " + std::to_string(c.normal_index + 1) +
+                    throw LoadError(shown_ + ": face normal index " + std::to_string(c.normal_index + 1) +
                                     " out of range (" + std::to_string(nn) + " normals)");
                 if (c.texcoord_index < -1 || c.texcoord_index >= nt)
-                    throw LoadError(path_ + ": face texcoord index " +
+                    throw LoadError(shown_ + ": face texcoord index " +
                                     std::to_string(c.texcoord_index + 1) + " out of range (" +
                                     std::to_string(nt) + " texcoords)");
                 need_normals |= c.normal_index < 0;
@@ -387,7 +400,8 @@ private:
             total += idx.size();
         }
         if (total > detail::kMaxSceneElements)
-            throw LoadError(path_ + ": too many triangles (" + std::to_string(total / 3) + ")");
+            throw LoadError(shown_ + ": too many triangles (" + std::to_string(total / 3) + " corners; at most " +
+                            std::to_string(detail::kMaxSceneElements) + ")");
         const std::vector<glm::vec3> smooth =
             need_normals ? position_normals(attrib, shapes) : std::vector<glm::vec3>();
 
@@ -452,6 +466,9 @@ private:
     }
 
     const std::string& path_;
+    const std::string shown_;  // path_, printable
+    FileScope scope_;
+    WarningLog log_;
     Scene scene_;
     std::vector<MtlKeys> keys_;
     std::map<std::string, int> image_index_;
@@ -459,14 +476,18 @@ private:
 
 } // namespace
 
-Scene load_obj(const std::string& path) {
+Scene load_obj(const std::string& path, const LoadOptions& options) {
     try {
-        return ObjLoader(path).load();
+        return ObjLoader(path, options).load();
     } catch (const LoadError&) {
         throw;
+    } catch (const std::bad_alloc&) {
+        throw LoadError(printable(path) + ": out of memory while loading the model");
+    } catch (const std::length_error&) {
+        throw LoadError(printable(path) + ": too large to load (a size exceeds what memory can hold)");
     } catch (const std::exception& e) {
-        // tinyobjloader and the standard library may throw (bad_alloc, length_error).
-        throw LoadError(path + ": " + e.what());
+        // tinyobjloader and the standard library may throw.
+        throw LoadError(printable(path) + ": cannot load: " + printable(e.what()));
     }
 }
 

@@ -11,19 +11,21 @@
 #include <system_error>
 #include <utility>
 
+#include "scene/file_access.h"
+#include "scene/messages.h"
 #include "scene/tangents.h"
 
 namespace prast {
 
 namespace fs = std::filesystem;
 
-Scene load_scene(const std::string& path) {
+Scene load_scene(const std::string& path, const LoadOptions& options) {
     std::error_code ec;
-    if (fs::is_directory(path, ec)) throw LoadError(path + ": is a directory, not a file");
+    if (fs::is_directory(path, ec)) throw LoadError(printable(path) + ": is a directory, not a file");
     const std::string ext = detail::extension_lower(path);
-    if (ext == ".obj") return load_obj(path);
-    if (ext == ".gltf" || ext == ".glb") return load_gltf(path);
-    throw LoadError(path + ": unknown extension '" + fs::path(path).extension().string() +
+    if (ext == ".obj") return load_obj(path, options);
+    if (ext == ".gltf" || ext == ".glb") return load_gltf(path, options);
+    throw LoadError(printable(path) + ": unknown extension '" + printable(fs::path(path).extension().string()) +
                     "' (expected .obj, .gltf or .glb)");
 }
 
@@ -36,23 +38,7 @@ std::string extension_lower(const std::string& path) {
 }
 
 std::vector<unsigned char> read_file(const std::string& path) {
-    std::error_code ec;
-    const fs::file_status st = fs::status(path, ec);
-    if (ec || !fs::exists(st)) throw LoadError(path + ": cannot open file (no such file)");
-    if (fs::is_directory(st)) throw LoadError(path + ": is a directory, not a file");
-    // FIFOs and devices could block or never end.
-    if (!fs::is_regular_file(st)) throw LoadError(path + ": not a regular file");
-    const std::uintmax_t size = fs::file_size(path, ec);
-    if (ec) throw LoadError(path + ": cannot read file size");
-    if (size == 0) throw LoadError(path + ": empty file");
-    if (size > kMaxFileBytes) throw LoadError(path + ": file too large (over 2 GiB)");
-
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw LoadError(path + ": cannot open file");
-    std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
-    in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size()));
-    if (std::size_t(in.gcount()) != bytes.size()) throw LoadError(path + ": read error");
-    return bytes;
+    return read_regular_file(path, kMaxFileBytes);
 }
 
 namespace {
@@ -153,7 +139,8 @@ bool repair_tangents(Mesh& m) {
 
 } // namespace
 
-void finish_scene(Scene& scene, const std::string& path) {
+void finish_scene(Scene& scene, const std::string& path_in) {
+    const std::string path = printable(path_in);
     std::size_t bad_index = 0, non_finite = 0, bad_normals = 0, bad_uvs = 0;
     int default_material = -1;
     std::vector<Mesh> kept;

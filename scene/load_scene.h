@@ -6,8 +6,12 @@
 // Errors: a file that cannot be used throws LoadError with one line
 // "FILE: problem". A problem the loader can work around (a missing texture, an
 // unsupported extension or primitive mode, triangles with NaN corners) is one
-// line "FILE: ..." in Scene::warnings, and the scene still loads. No input may
-// crash or hang a loader: every index, offset and size in the file is checked.
+// line "FILE: ..." in Scene::warnings, and the scene still loads; at most
+// kWarningsPerKind of a kind, then a count (scene/messages.h). No input may
+// crash or hang a loader: every index, offset and size in the file is checked,
+// every count against a budget before anything is allocated, and every other
+// file a model names is read through scene/file_access.h (confined to the
+// model's folder). Names from the file are escaped in every message.
 #pragma once
 
 #include <cstddef>
@@ -18,24 +22,35 @@
 
 namespace prast {
 
+struct LoadOptions {
+    // Let references (mtllib, map_*, uris) leave the model's folder; see
+    // scene/file_access.h for the rule this lifts (render --allow-outside-paths).
+    bool allow_outside_paths = false;
+};
+
 // Dispatches on the extension, case-insensitively: .obj, .gltf or .glb.
-Scene load_scene(const std::string& path);
+Scene load_scene(const std::string& path, const LoadOptions& options = {});
 
 // OBJ + MTL. One Mesh per (object/group, material); UVs become v = 1 - v_obj.
-Scene load_obj(const std::string& path);
+Scene load_obj(const std::string& path, const LoadOptions& options = {});
 
 // glTF 2.0, text (.gltf) or binary (.glb): the default scene's node hierarchy
 // is flattened into world-space meshes; KHR_lights_punctual gives the lights.
-Scene load_gltf(const std::string& path);
+Scene load_gltf(const std::string& path, const LoadOptions& options = {});
 
 namespace detail {
 
 // Limits that keep a hostile file from exhausting memory; each is far beyond
-// the assets the project renders (the largest has 70 k triangles).
+// the assets the project renders (the largest has 70 k triangles) and the
+// 10-million-triangle model of the tests (31 million elements).
 constexpr std::size_t kMaxFileBytes = std::size_t(1) << 31;      // 2 GiB
-constexpr std::size_t kMaxSceneElements = std::size_t(1) << 28;  // vertices or indices
+constexpr std::size_t kMaxSceneElements = std::size_t(1) << 27;  // vertices + indices
+// glTF accessor elements without a bufferView are zeros made up by the
+// loader, not read from the file: a 400-byte file could ask for billions.
+constexpr std::size_t kMaxZeroFilledElements = std::size_t(1) << 22;
 
-// The whole file, or LoadError "PATH: cannot open file" / "is a directory" /
+// The whole regular file (file_access.h's read_regular_file), or LoadError
+// "PATH: cannot open file" / "is a directory" / "not a regular file" /
 // "empty file" / "file too large".
 std::vector<unsigned char> read_file(const std::string& path);
 

@@ -1,10 +1,14 @@
 // Atomic PNG/HDR output; see image_write.h.
 #include "scene/write_image.h"
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <new>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <stb_image_write.h>
@@ -21,22 +25,58 @@ void append_bytes(void* ctx, void* data, int size) {
     out->insert(out->end(), p, p + size);
 }
 
+// The temporary file being written, for remove_temporary_output(): plain
+// storage and a lock-free flag, all a signal handler may touch.
+char g_pending_path[4097];
+std::atomic<bool> g_pending{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "a signal handler reads the flag");
+
+struct PendingGuard {
+    ~PendingGuard() { g_pending.store(false); }
+};
+
 void write_file_atomic(const std::string& path, const std::vector<std::uint8_t>& bytes) {
-    std::string tmp = path + ".tmp" + std::to_string(long(getpid()));
-    std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw WriteError(path + ": cannot write (" + std::strerror(errno) + ")");
-    bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-    ok &= std::fflush(f) == 0;
-    ok &= fsync(fileno(f)) == 0;
-    int err = errno;
-    ok &= std::fclose(f) == 0;
+    // Next to the target (rename must not cross file systems), hidden, and
+    // short: "<target>.tmp<pid>" would pass NAME_MAX for a 250-byte name.
+    const std::filesystem::path target(path);
+    std::string base = target.filename().string();
+    if (base.size() > 64) base.resize(64);
+    const std::string tmp = (target.parent_path() / ("." + base + "." + std::to_string(long(getpid())) + ".tmp")).string();
+    if (tmp.size() >= sizeof g_pending_path) throw WriteError(path + ": cannot write (path too long)");
+    std::memcpy(g_pending_path, tmp.c_str(), tmp.size() + 1);
+    g_pending.store(true);
+    PendingGuard pending;
+
+    // O_NOFOLLOW: a symbolic link planted under the temporary name is not followed.
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0666);
+    if (fd < 0) throw WriteError(path + ": cannot write (" + std::strerror(errno) + ")");
+    bool ok = true;
+    int err = 0;
+    for (std::size_t done = 0; ok && done < bytes.size();) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            ok = false;
+            err = n < 0 ? errno : EIO;
+        } else {
+            done += std::size_t(n);
+        }
+    }
+    if (ok && ::fsync(fd) != 0) {
+        ok = false;
+        err = errno;
+    }
+    if (::close(fd) != 0 && ok) {
+        ok = false;
+        err = errno;
+    }
     if (!ok) {
-        std::remove(tmp.c_str());
+        ::unlink(tmp.c_str());
         throw WriteError(path + ": write failed (" + std::strerror(err) + ")");
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
         err = errno;
-        std::remove(tmp.c_str());
+        ::unlink(tmp.c_str());
         throw WriteError(path + ": cannot replace (" + std::strerror(err) + ")");
     }
 }
@@ -52,13 +92,27 @@ std::vector<std::uint8_t> encode_png(int width, int height, const std::uint8_t* 
     }
     try {
         return encode_png_pixels(rgb.data(), width, height, 3, png_options_threads());
+    } catch (const std::bad_alloc&) {
+        throw WriteError("PNG encoding failed: out of memory");
     } catch (const std::exception& e) {
         throw WriteError(std::string("PNG encoding failed: ") + e.what());
     }
 }
 
+void remove_temporary_output() noexcept {
+    if (g_pending.load()) ::unlink(g_pending_path);
+}
+
 void write_png_atomic(const std::string& path, int width, int height, const std::uint8_t* rgba8) {
-    write_file_atomic(path, encode_png(width, height, rgba8));
+    std::vector<std::uint8_t> bytes;
+    try {
+        bytes = encode_png(width, height, rgba8);
+    } catch (const std::bad_alloc&) {
+        throw WriteError(path + ": PNG encoding failed (out of memory)");
+    } catch (const WriteError& e) {
+        throw WriteError(path + ": " + e.what());
+    }
+    write_file_atomic(path, bytes);
 }
 
 void write_hdr_atomic(const std::string& path, int width, int height, const float* rgba) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <new>
 
 #include "scene/image.h"
 #include "shading/resolve.h"
@@ -93,6 +94,8 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
         try {
             images[slot] = src.decoded ? *src.decoded : decode_image(src, slot % 2 == 1);
             decoded[slot] = 1;
+        } catch (const std::bad_alloc&) {
+            errors[slot] = (src.name.empty() ? src.path : src.name) + ": out of memory while decoding";
         } catch (const std::exception& e) {
             errors[slot] = e.what();
         }
@@ -123,6 +126,9 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
         try {
             textures_[slot] = std::make_unique<Texture>(
                 Texture::from_image(std::move(images[slot]), ws, wt, &renderer.pool()));
+        } catch (const std::bad_alloc&) {
+            const ImageSource& src = scene.images[slot / 2];
+            errors[slot] = (src.name.empty() ? src.path : src.name) + ": out of memory while building its mip maps";
         } catch (const std::exception& e) {
             errors[slot] = e.what();
         }

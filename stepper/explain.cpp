@@ -8,6 +8,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "scene/messages.h"
 #include "shading/color.h"
 #include "shading/tonemap.h"
 #include "stepper/format.h"
@@ -35,7 +36,8 @@ std::string mesh_name(const StepScene& s, const Recording& rec, std::uint32_t tr
 
 namespace {
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
+// Names come from the model: escaped, so they cannot drive the terminal.
+std::string quoted(const std::string& s) { return "'" + printable(s) + "'"; }
 
 json j3(const glm::vec3& v) { return json::array({v.x, v.y, v.z}); }
 

@@ -80,9 +80,11 @@ TEST_CASE("parser: every flag reaches the options") {
     REQUIRE(parse("scene.glb -o out%03d.hdr --size 96x64 --eye 1,2,3 --target=0,1,0 --up 0,0,1 --fov 30 "
                   "--near 0.5 --far 50 --sun 0,2,0:1,2,3 --point 1,1,1:4,4,4 --ambient 0.1,0.2,0.3 "
                   "--no-default-lights --brdf gltf --exposure 2.5 --tonemap neutral --view normal "
-                  "--threads 3 --tile 16 --frames 8 --orbit -90 --frame-range 2-5 --repeat 4 --stats --pixel 5,6",
+                  "--threads 3 --tile 16 --frames 8 --orbit -90 --frame-range 2-5 --repeat 4 --stats --pixel 5,6 "
+                  "--allow-outside-paths",
                   o) == "");
     CHECK(o.scene == "scene.glb");
+    CHECK(o.allow_outside_paths);
     CHECK(o.output == "out%03d.hdr");
     CHECK(o.hdr_output());
     CHECK(o.width == 96);
@@ -139,6 +141,10 @@ TEST_CASE("parser: errors name the flag and the bad value") {
         {"--fov inf", "--fov 'inf'"},
         {"--fov -5", "--fov '-5'"},
         {"--fov 180", "--fov '180'"},
+        {"--fov 0.0001", "--fov '0.0001': must be at least 0.001"},
+        {"--eye 0,0,2e18", "--eye '0,0,2e18': coordinates beyond +-1e18"},
+        {"--target -1e19,0,0", "--target '-1e19,0,0': coordinates beyond +-1e18"},
+        {"--allow-outside-paths=yes", "--allow-outside-paths: takes no value"},
         {"--near -1", "--near '-1'"},
         {"--near 5 --far 1", "--near/--far"},
         {"--exposure -1", "--exposure '-1'"},
@@ -262,7 +268,7 @@ TEST_CASE("--help fits a 80x24 screen and --version prints the version") {
     for (const char* flag : {"--output", "--size", "--eye", "--fov", "--near", "--sun", "--point", "--ambient",
                              "--no-default-lights", "--env", "--brdf", "--exposure", "--tonemap", "--view",
                              "--threads", "--tile", "--frames", "--orbit", "--frame-range", "--repeat", "--stats",
-                             "--pixel", "--version"})
+                             "--pixel", "--allow-outside-paths", "--version"})
         CHECK(help.out.find(flag) != std::string::npos);
     for (const char* flag : {"--env-intensity", "--env-rotate", "--background", "--ibl", "--samples", "--energy"})
         CHECK(help.out.find(flag) != std::string::npos);

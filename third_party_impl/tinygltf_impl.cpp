@@ -6,4 +6,6 @@
 #define TINYGLTF_NO_STB_IMAGE_WRITE
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE_WRITE
+// Image files are opened by scene/load_gltf.cpp through its FileScope, never by tinygltf.
+#define TINYGLTF_NO_EXTERNAL_IMAGE
 #include <tiny_gltf.h>

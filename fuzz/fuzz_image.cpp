@@ -1,0 +1,19 @@
+// libFuzzer harness: image decoding (scene/image.cpp: our PNG decoder and
+// libpng, stb_image behind the HDR and JPEG guards), one build per format:
+// PRAST_FUZZ_PNG, PRAST_FUZZ_JPEG or PRAST_FUZZ_HDR (fuzz/targets.h: run_image).
+#include "fuzz/targets.h"
+
+#if defined(PRAST_FUZZ_PNG)
+constexpr prast::fuzz::Target kTarget = prast::fuzz::Target::Png;
+#elif defined(PRAST_FUZZ_JPEG)
+constexpr prast::fuzz::Target kTarget = prast::fuzz::Target::Jpeg;
+#elif defined(PRAST_FUZZ_HDR)
+constexpr prast::fuzz::Target kTarget = prast::fuzz::Target::Hdr;
+#else
+#error "define PRAST_FUZZ_PNG, PRAST_FUZZ_JPEG or PRAST_FUZZ_HDR"
+#endif
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    if (!prast::fuzz::run_image(kTarget, data, size)) __builtin_trap();  // header and decode disagree
+    return 0;
+}
