@@ -412,14 +412,18 @@ std::string png_data_shortfall(const unsigned char* data, std::size_t size, int 
     const std::int64_t bits = std::int64_t(kSamples[colour]) * depth;
     const std::int64_t need = std::int64_t(w) * std::int64_t(h) * bits / 8;
     std::int64_t idat = 0;
-    for (std::size_t pos = 8; pos + 12 <= size;) {
+    // A chunk header (length and type) is 8 bytes: stb_image reads those and
+    // grows its buffer before it looks for the data and CRC, so a header that
+    // fits with its data cut off is refused as well.
+    for (std::size_t pos = 8; pos + 8 <= size;) {
         const std::uint32_t len = be32(data + pos);
         const std::string type = printable(std::string(reinterpret_cast<const char*>(data + pos + 4), 4));
         // A chunk past the end of the file: stb_image 2.27 grows its buffer
         // to the claimed length first (up to 4 GiB for one 16-bit file).
-        if (len > size - pos - 12)
+        const std::size_t left = size - pos - 8;  // after the header
+        if (left < 4 || len > left - 4)
             return "truncated: the " + type + " chunk at byte " + std::to_string(pos) + " claims " +
-                   std::to_string(len) + " bytes, " + std::to_string(size - pos - 12) + " are left";
+                   std::to_string(len) + " bytes, " + std::to_string(left < 4 ? 0 : left - 4) + " are left";
         if (type == "IDAT") idat += len;
         if (type == "IEND") break;
         pos += 12 + std::size_t(len);
