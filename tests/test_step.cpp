@@ -398,9 +398,10 @@ TEST_CASE("flags: step takes every flag of render's --help, or refuses it") {
     REQUIRE(step_help.code == 0);
     const std::vector<std::string> listed = flags(step_help.out);
     // render-only: one frame has no turntable, output file, repeat, stats or
-    // debug view; --samples belongs to --ibl reference, which step refuses.
+    // debug view; --samples belongs to --ibl reference, which step refuses;
+    // step never reads outside the model's folder (it may serve what it reads).
     const std::vector<std::string> refused = {"--output", "--frames", "--orbit", "--frame-range", "--repeat",
-                                              "--view", "--stats"};
+                                              "--view", "--stats", "--allow-outside-paths"};
     for (const std::string& f : flags(render_help.out)) {
         INFO("render flag " << f);
         if (std::find(listed.begin(), listed.end(), f) != listed.end() || f == "--samples") continue;
