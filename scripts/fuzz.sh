@@ -19,7 +19,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 [ $# -gt 0 ] && shift
 harnesses=${*:-obj gltf png jpeg hdr cli step}
-out=build-fuzz
+out="$PWD/build-fuzz"  # absolute: fuzz_step works in a folder of its own
 export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}"
 if [ ! -f $out/CMakeCache.txt ]; then
   launcher=""
@@ -39,7 +39,7 @@ status=0
 for h in $harnesses; do
   mkdir -p $out/corpus/$h $out/findings/$h
   extra=""
-  [ -d tests/fuzz-regressions/$h ] && extra=tests/fuzz-regressions/$h
+  [ -d tests/fuzz-regressions/$h ] && extra="$PWD/tests/fuzz-regressions/$h"
   echo "==== fuzz_$h for $seconds s"
   # shellcheck disable=SC2086
   if ! $out/fuzz/fuzz_$h -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
