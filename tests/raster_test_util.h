@@ -60,4 +60,24 @@ inline std::uint64_t hash_framebuffer(const Framebuffer& fb) {
     return fnv1a(fb.depth.data(), fb.depth.size() * sizeof(float), h);
 }
 
+// splitmix64: the same numbers on every platform.
+struct Random {
+    std::uint64_t s;
+    explicit Random(std::uint64_t seed) : s(seed) {}
+    std::uint64_t next() {
+        std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    double uniform() { return double(next() >> 11) * (1.0 / 9007199254740992.0); }
+    double range(double a, double b) { return a + (b - a) * uniform(); }
+};
+
+// Clip-space position of window point (x, y) of a W x H target (y down), at
+// NDC depth z_ndc, scaled by w.
+inline glm::vec4 at(double x, double y, int W, int H, double z_ndc = 0.0, double w = 1.0) {
+    return {float((x / W * 2.0 - 1.0) * w), float((1.0 - y / H * 2.0) * w), float(z_ndc * w), float(w)};
+}
+
 } // namespace prast::test
