@@ -218,7 +218,9 @@ inline void apply_energy_terms(BrdfInputs& in, const DfgTable& table) {
 
 // The BRDF inputs at a point, all but the light direction: shade_surface,
 // the debug views and the stepper build them the same way.
-inline BrdfInputs brdf_inputs(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx) {
+// Without the energy terms, which lights and the environment take from
+// different tables.
+inline BrdfInputs plain_brdf_inputs(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx) {
     BrdfInputs in;
     in.n = ms.N;
     in.v = surface_detail::safe_normalize(ctx.eye - sp.P, ms.N);
@@ -227,6 +229,11 @@ inline BrdfInputs brdf_inputs(const MaterialSample& ms, const SurfacePoint& sp, 
     in.roughness = ms.roughness;
     in.ior = ms.ior;
     in.conductor = ms.conductor;
+    return in;
+}
+
+inline BrdfInputs brdf_inputs(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx) {
+    BrdfInputs in = plain_brdf_inputs(ms, sp, ctx);
     if (ctx.energy && ctx.dfg_light) apply_energy_terms(in, *ctx.dfg_light);
     return in;
 }
@@ -307,14 +314,7 @@ inline IblTerms ibl_terms(const MaterialSample& ms, const SurfacePoint& sp, cons
 // (ibl_reference.h), times occlusion. ctx.env and ctx.dfg_ibl must be set.
 inline glm::vec3 ibl_reference(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx,
                                int samples) {
-    BrdfInputs in;
-    in.n = ms.N;
-    in.v = surface_detail::safe_normalize(ctx.eye - sp.P, ms.N);
-    in.albedo = ms.albedo;
-    in.metallic = ms.metallic;
-    in.roughness = ms.roughness;
-    in.ior = ms.ior;
-    in.conductor = ms.conductor;
+    BrdfInputs in = plain_brdf_inputs(ms, sp, ctx);
     if (ctx.energy) apply_energy_terms(in, *ctx.dfg_ibl);
     return integrate_environment(*ctx.env, in, ctx.model, samples) * ms.occlusion;
 }
