@@ -11,6 +11,8 @@
 //                                        --shadows applies to the workloads too)
 //                                        (any scene, the built-in one by default; --tiles, --view
 //                                        or --flat without SCENE also select this mode)
+//   bench --alternate [--threads 1,2] ...  one process, frames of each thread count in
+//                                        turn; prints the median of the rounds' speed-ups
 //   bench --write-workloads DIR          the synthetic workloads as files, plus DIR/commands.txt
 //   bench --side-by-side RENDER_A RENDER_B [--workload ...] [--runs N] [--repeat N]
 //   bench --psnr A.png B.png
@@ -36,6 +38,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -477,6 +480,97 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
     return r;
 }
 
+// bench --alternate: one renderer per thread count in one process, their
+// frames taken in turn (round k: a frame at each count), so that a change in
+// the machine's load reaches every count alike. The speed-up is the median of
+// the rounds' ratios (first count's frame / this count's frame).
+void measure_alternating(const Workload& w, const std::vector<int>& threads, int tile, int repeat, int width,
+                         int height, int samples, bool json, std::vector<std::string>& out) {
+    DefaultScene builtin;
+    Scene loaded;
+    const Scene* scene;
+    Camera cam;
+    if (w.file.empty()) {
+        builtin = make_default_scene();
+        scene = &builtin.scene;
+        cam = builtin.camera;
+    } else {
+        loaded = load_scene(w.file);
+        scene = &loaded;
+        cam.eye = w.eye;
+        cam.target = w.target;
+        cam.fov_y_deg = w.fov;
+    }
+    fit_clip_planes(cam, scene->bounds());
+    FrameSettings fs;
+    fs.camera = cam;
+    if (w.own_lights) {
+        fs.lights = shading_lights(*scene);
+    } else {
+        ShadingLight sun;
+        sun.direction = glm::normalize(glm::vec3(0.35f, 0.6f, 0.7f));
+        sun.radiance = glm::vec3(3.0f);
+        fs.lights = {sun};
+    }
+    fs.ambient = glm::vec3(0.05f);
+    fs.samples = samples;
+    const std::size_t n = threads.size();
+    std::vector<std::unique_ptr<Renderer>> renderers;
+    std::vector<std::unique_ptr<SceneRenderer>> srs;
+    std::vector<Framebuffer> fbs;
+    std::vector<std::vector<std::uint8_t>> images(n, std::vector<std::uint8_t>(std::size_t(width) * std::size_t(height) * 4));
+    for (std::size_t i = 0; i < n; ++i) {
+        renderers.push_back(std::make_unique<Renderer>(RendererOptions{threads[i], tile}));
+        srs.push_back(std::make_unique<SceneRenderer>(*scene, *renderers.back()));
+        fbs.emplace_back(width, height);
+    }
+    std::vector<std::vector<double>> ms(n), ratio(n), pass(n), cpu(n), idle(n);
+    for (int k = 0; k <= repeat; ++k) {  // round 0 warms up
+        std::vector<double> round(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            ImageOutput o;
+            o.rgba8 = images[i].data();
+            o.tonemap = ToneMap::Aces;
+            auto t0 = Clock::now();
+            srs[i]->render(fs, fbs[i], &o);
+            round[i] = ms_since(t0);
+            if (k == 0) continue;
+            const FrameStats& st = renderers[i]->stats();
+            pass[i].push_back(st.ms_raster);
+            cpu[i].push_back(st.ms_tiles_cpu);
+            idle[i].push_back(double(renderers[i]->threads()) * st.ms_raster - st.ms_tiles_busy);
+        }
+        if (k == 0) continue;
+        for (std::size_t i = 0; i < n; ++i) {
+            ms[i].push_back(round[i]);
+            ratio[i].push_back(round[0] / round[i]);
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        const Summary f = summarise(ms[i]), r = summarise(ratio[i]);
+        const double pass_ms = summarise(pass[i]).median, cpu_ms = summarise(cpu[i]).median,
+                     idle_ms = summarise(idle[i]).median;
+        const bool same = images[i] == images[0];
+        char b[512];
+        if (json) {
+            std::snprintf(b, sizeof b,
+                          "{\"workload\":\"%s\",\"threads\":%d,\"msaa\":%d,\"alternate\":true,"
+                          "\"frame_ms\":{\"min\":%.3f,\"median\":%.3f,\"max\":%.3f},"
+                          "\"speedup\":{\"min\":%.3f,\"median\":%.3f,\"max\":%.3f},\"tile_pass_ms\":%.3f,"
+                          "\"tile_pass_cpu_ms\":%.3f,\"tile_pass_idle_ms\":%.3f,\"same_image\":%s}",
+                          w.name.c_str(), threads[i], samples, f.min, f.median, f.max, r.min, r.median, r.max,
+                          pass_ms, cpu_ms, idle_ms, same ? "true" : "false");
+            out.push_back(b);
+        } else {
+            std::printf("%-8s threads %d msaa %d: frame_ms min=%.2f median=%.2f max=%.2f  %d -> %d threads: "
+                        "%.2fx (rounds %.2fx..%.2fx)  tile pass %.2f ms: CPU %.2f ms, idle %.2f ms%s\n",
+                        w.name.c_str(), threads[i], samples, f.min, f.median, f.max, threads[0], threads[i],
+                        r.median, r.min, r.max, pass_ms, cpu_ms, idle_ms, same ? "" : "  IMAGE DIFFERS");
+            std::fflush(stdout);
+        }
+    }
+}
+
 void print_result(const Result& r) {
     std::printf("%-8s threads %d msaa %d: frame_ms min=%.2f median=%.2f max=%.2f  (vertex %.2f, setup+bin %.2f, "
                 "raster+shade+resolve %.2f)  png %.1f ms %zu B | %zu tris, %.1f%% drawn, load %.1f ms, "
@@ -723,6 +817,7 @@ int bench_scene(const std::string& scene_path, int width, int height, const std:
 int usage() {
     std::fprintf(stderr,
                  "usage: bench [--workload quad,grid,bottle,tea,bunny,builtin] [--threads 1,2] [--msaa 1,4] [--repeat N] [--json]\n"
+                 "             [--alternate]  (frames of each thread count in turn, speed-up per round)\n"
                  "       bench SCENE [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME] [--flat]\n"
                  "             [--shadows on|off|both] [--shadow-size N] [--blend ALPHA]\n"
                  "       bench --write-workloads DIR\n"
@@ -748,7 +843,7 @@ int main(int argc, char** argv) {
     std::vector<int> threads = {2}, tiles = {kDefaultTileSize};
     std::vector<std::string> names;
     DebugView view = DebugView::None;
-    bool flat = false, json = false, threads_given = false, tiles_given = false, blend_given = false;
+    bool flat = false, json = false, alternate = false, threads_given = false, tiles_given = false, blend_given = false;
     FeatureOptions features;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
@@ -782,6 +877,7 @@ int main(int argc, char** argv) {
             blend_given = true;
         }
         else if (a == "--json") json = true;
+        else if (a == "--alternate") alternate = true;
         else if (a == "--workload") names = split(next());
         else if (a == "--workloads") dir = next();
         else if (a == "--assets") assets = next();
@@ -826,7 +922,11 @@ int main(int argc, char** argv) {
         }
         std::vector<std::string> out;
         for (const Workload& w : list)
-            for (int m : msaa)
+            for (int m : msaa) {
+                if (alternate) {
+                    measure_alternating(w, threads, tiles.front(), repeat, width, height, m, json, out);
+                    continue;
+                }
                 for (int t : threads)
                     for (bool shadows : features.shadows) {
                         Result r = measure(w, t, tiles.front(), repeat, width, height, m, shadows,
@@ -836,6 +936,7 @@ int main(int argc, char** argv) {
                         if (!json) print_result(r);
                         out.push_back(json_result(r));
                     }
+            }
         if (json) {
             std::printf("[");
             for (std::size_t i = 0; i < out.size(); ++i) std::printf("%s%s\n", i ? "," : "", out[i].c_str());

@@ -174,11 +174,15 @@ void Renderer::finish(TileHook hook, void* user) {
         }
     }
     worker_stats_.assign(std::size_t(workers), FrameStats{});
+    pool_.reset_usage();
     pool_.run(int(tile_order_.size()), [&](int task, int worker) {
         run_tile(tile_order_[std::size_t(task)], worker, hook, user);
     });
     for (const FrameStats& ws : worker_stats_) stats_.add_counters(ws);
     stats_.ms_raster += ms_since(t0);
+    const ThreadPool::Usage usage = pool_.usage();
+    stats_.ms_tiles_cpu += usage.cpu_ms;
+    stats_.ms_tiles_busy += usage.busy_ms;
 }
 
 void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {

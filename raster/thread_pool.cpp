@@ -1,11 +1,24 @@
 // Persistent worker threads; see thread_pool.h.
 #include "raster/thread_pool.h"
 
+#include <chrono>
+#include <ctime>
 #include <system_error>
 
 namespace prast {
 
+namespace {
+
+double thread_cpu_ms() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+} // namespace
+
 ThreadPool::ThreadPool(int threads) : requested_(threads < 1 ? 1 : threads) {
+    usage_.resize(std::size_t(requested_));
     workers_.reserve(std::size_t(requested_ - 1));
     for (int i = 1; i < requested_; ++i) {
         try {
@@ -40,6 +53,27 @@ int ThreadPool::hardware_threads() {
     return n == 0 ? 1 : int(n);
 }
 
+ThreadPool::Usage ThreadPool::usage() const {
+    Usage u;
+    for (const Usage& w : usage_) {
+        u.cpu_ms += w.cpu_ms;
+        u.busy_ms += w.busy_ms;
+    }
+    return u;
+}
+
+void ThreadPool::reset_usage() { usage_.assign(usage_.size(), Usage{}); }
+
+void ThreadPool::work_measured(int worker) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    const double c0 = thread_cpu_ms();
+    work(worker);
+    Usage& u = usage_[std::size_t(worker)];
+    u.cpu_ms += thread_cpu_ms() - c0;
+    u.busy_ms += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
 void ThreadPool::work(int worker) {
     for (;;) {
         int task = next_.fetch_add(1, std::memory_order_relaxed);
@@ -59,6 +93,18 @@ void ThreadPool::work(int worker) {
 void ThreadPool::run(int count, const std::function<void(int, int)>& fn) {
     if (count <= 0) return;
     if (workers_.empty() || count == 1) {
+        using Clock = std::chrono::steady_clock;
+        const auto t0 = Clock::now();
+        const double c0 = thread_cpu_ms();
+        struct Account {  // also when a task throws
+            Usage& u;
+            Clock::time_point t0;
+            double c0;
+            ~Account() {
+                u.cpu_ms += thread_cpu_ms() - c0;
+                u.busy_ms += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+            }
+        } account{usage_[0], t0, c0};
         for (int t = 0; t < count; ++t) fn(t, 0);
         return;
     }
@@ -72,7 +118,7 @@ void ThreadPool::run(int count, const std::function<void(int, int)>& fn) {
         ++generation_;
     }
     start_cv_.notify_all();
-    work(0);
+    work_measured(0);
     std::exception_ptr error;
     {
         std::unique_lock<std::mutex> lock(mutex_);
@@ -93,7 +139,7 @@ void ThreadPool::worker_loop(int worker) {
             seen = generation_;
             if (stop_) return;
         }
-        work(worker);
+        work_measured(worker);
         {
             std::lock_guard<std::mutex> lock(mutex_);
             if (--busy_ == 0) done_cv_.notify_one();

@@ -41,9 +41,23 @@ public:
 
     static int hardware_threads();
 
+    // What the threads spent inside runs since reset_usage(), summed over
+    // threads: CPU time (the thread's own clock: time the machine gave to
+    // other processes is not counted) and wall time from a thread's start on
+    // a run to its finding no task left. Against the wall time of the runs,
+    // busy_ms says how long threads waited for one another or for a wake-up;
+    // cpu_ms against the same work on one thread, what the threads cost each
+    // other (shared memory bandwidth and caches). Read between runs.
+    struct Usage {
+        double cpu_ms = 0, busy_ms = 0;
+    };
+    Usage usage() const;
+    void reset_usage();
+
 private:
     void worker_loop(int worker);
     void work(int worker);
+    void work_measured(int worker);
     void shut_down();
 
     std::vector<std::thread> workers_;
@@ -58,6 +72,7 @@ private:
     unsigned generation_ = 0;   // bumps once per run
     bool stop_ = false;
     std::exception_ptr error_;  // first task failure of the current run
+    std::vector<Usage> usage_;  // by worker, each written by its own thread
 };
 
 } // namespace prast
