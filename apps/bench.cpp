@@ -536,9 +536,10 @@ void measure_alternating(const Workload& w, const std::vector<int>& threads, int
             round[i] = ms_since(t0);
             if (k == 0) continue;
             const FrameStats& st = renderers[i]->stats();
+            const ThreadPool::Usage& u = renderers[i]->tile_usage();
             pass[i].push_back(st.ms_raster);
-            cpu[i].push_back(st.ms_tiles_cpu);
-            idle[i].push_back(double(renderers[i]->threads()) * st.ms_raster - st.ms_tiles_busy);
+            cpu[i].push_back(u.cpu_ms);
+            idle[i].push_back(double(renderers[i]->threads()) * st.ms_raster - u.busy_ms);
         }
         if (k == 0) continue;
         for (std::size_t i = 0; i < n; ++i) {

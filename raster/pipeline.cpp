@@ -181,8 +181,8 @@ void Renderer::finish(TileHook hook, void* user) {
     for (const FrameStats& ws : worker_stats_) stats_.add_counters(ws);
     stats_.ms_raster += ms_since(t0);
     const ThreadPool::Usage usage = pool_.usage();
-    stats_.ms_tiles_cpu += usage.cpu_ms;
-    stats_.ms_tiles_busy += usage.busy_ms;
+    tile_usage_.cpu_ms += usage.cpu_ms;
+    tile_usage_.busy_ms += usage.busy_ms;
 }
 
 void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {

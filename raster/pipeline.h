@@ -51,8 +51,13 @@ public:
     void clear(Framebuffer& fb, float r, float g, float b, float a, float z = 1.0f);
 
     // Counters accumulate over frames and draws until the next begin_frame().
-    void begin_frame() { stats_ = FrameStats{}; tile_entries_.clear(); }
+    void begin_frame() { stats_ = FrameStats{}; tile_entries_.clear(); tile_usage_ = {}; }
     const FrameStats& stats() const { return stats_; }
+    // The tile passes of the counted frames summed over the threads: CPU time
+    // and time from starting on a pass to finding no tile left
+    // (ThreadPool::Usage); threads() * stats().ms_raster - busy_ms is time a
+    // thread waited. For bench.
+    const ThreadPool::Usage& tile_usage() const { return tile_usage_; }
     // Bin entries per tile over the counted frames (row-major tiles of the
     // last framebuffer size): the `tiles` debug view and the stepper show it.
     const std::vector<std::uint32_t>& tile_entries() const { return tile_entries_; }
@@ -134,6 +139,7 @@ private:
     std::vector<int> tile_order_;
     std::vector<std::uint32_t> tile_entries_;
     FrameStats stats_;
+    ThreadPool::Usage tile_usage_;
 };
 
 template <class Program, class Observer>

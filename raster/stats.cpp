@@ -27,8 +27,6 @@ void FrameStats::add_counters(const FrameStats& o) {
     ms_vertex += o.ms_vertex;
     ms_setup_bin += o.ms_setup_bin;
     ms_raster += o.ms_raster;
-    ms_tiles_cpu += o.ms_tiles_cpu;
-    ms_tiles_busy += o.ms_tiles_busy;
 }
 
 std::string FrameStats::to_string() const {

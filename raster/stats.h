@@ -30,11 +30,6 @@ struct FrameStats {
     std::uint64_t fragments_written = 0;
     std::uint64_t fragments_shaded = 0;    // live lanes the fragment program ran for
     double ms_vertex = 0, ms_setup_bin = 0, ms_raster = 0;
-    // The tile pass (ms_raster is its wall time) summed over the threads:
-    // their CPU time and their wall time from starting on it to finding no
-    // tile left (ThreadPool::Usage). threads * ms_raster - ms_tiles_busy is
-    // time a thread waited.
-    double ms_tiles_cpu = 0, ms_tiles_busy = 0;
 
     void add_counters(const FrameStats& o);
     std::string to_string() const;  // multi-line, for --stats
