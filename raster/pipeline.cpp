@@ -249,7 +249,8 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
 
     // Start: clear, or (several samples) load the target's pixels.
     if (options_.clear) {
-        if (direct) clear_tile(fb, r, options_.clear_color, options_.clear_depth);
+        if (uniform && direct) clear_tile_streaming(fb, r, options_.clear_color, options_.clear_depth);
+        else if (direct) clear_tile(fb, r, options_.clear_color, options_.clear_depth);
         else clear_samples(tg.color, tg.depth, T, S, options_.clear_color, options_.clear_depth);
         if (options_.clear_fill && tg.color) {
             if (S == 1) {

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "raster/stream_fill.h"
+
 namespace prast {
 
 void clear_tile(Framebuffer& fb, const TileRect& r, const float rgba[4], float depth) {
@@ -15,6 +17,17 @@ void clear_tile(Framebuffer& fb, const TileRect& r, const float rgba[4], float d
         float* c = &fb.color[row * 4];
         for (std::size_t i = 0; i < w; ++i, c += 4) std::memcpy(c, rgba, 4 * sizeof(float));
     }
+}
+
+void clear_tile_streaming(Framebuffer& fb, const TileRect& r, const float rgba[4], float depth) {
+    const std::size_t w = std::size_t(r.width());
+    const StreamPattern z(&depth, sizeof(float)), c(rgba, 4 * sizeof(float));
+    for (int y = r.y0; y <= r.y1; ++y) {
+        const std::size_t row = std::size_t(y) * std::size_t(fb.width) + std::size_t(r.x0);
+        stream_fill(&fb.depth[row], w * sizeof(float), z);
+        if (fb.has_color()) stream_fill(&fb.color[row * 4], w * 4 * sizeof(float), c);
+    }
+    stream_fence();
 }
 
 void clear_samples(float* color, float* depth, int size, int samples, const float rgba[4], float z) {

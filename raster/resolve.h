@@ -19,6 +19,9 @@ struct TileRect {
 
 // One sample: fill the framebuffer's pixels of the tile.
 void clear_tile(Framebuffer& fb, const TileRect& r, const float rgba[4], float depth);
+// The same bytes with non-temporal stores (stream_fill.h), for a tile no draw
+// reaches: nothing reads its pixels again in the frame.
+void clear_tile_streaming(Framebuffer& fb, const TileRect& r, const float rgba[4], float depth);
 
 // Several samples in tile-local planes (`size` x `size` pixels each, colour
 // RGBA; color may be null for a depth target): fill every plane, or load

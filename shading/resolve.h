@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "raster/frame.h"
+#include "raster/stream_fill.h"
 #include "shading/tonemap.h"
 
 namespace prast {
@@ -35,10 +36,11 @@ struct TileResolve {
             std::uint8_t px[4];
             if (raw) resolve_pixels_raw8(v.rgba, 1, px);
             else resolve_pixels_srgb8(v.rgba, 1, exposure, tonemap, px);
-            for (int y = 0; y < v.height; ++y) {
-                std::uint8_t* out = rgba8 + (std::size_t(v.y0 + y) * std::size_t(width) + std::size_t(v.x0)) * 4;
-                for (int x = 0; x < v.width; ++x) std::memcpy(out + 4 * x, px, 4);
-            }
+            const StreamPattern pattern(px, 4);
+            for (int y = 0; y < v.height; ++y)  // not read again this frame: streamed
+                stream_fill(rgba8 + (std::size_t(v.y0 + y) * std::size_t(width) + std::size_t(v.x0)) * 4,
+                            std::size_t(v.width) * 4, pattern);
+            stream_fence();
             return;
         }
         for (int y = 0; y < v.height; ++y) {

@@ -15,6 +15,7 @@
 
 #include <glm/glm.hpp>
 
+#include "raster/stream_fill.h"
 #include "shading/resolve.h"
 #include "shading/tonemap.h"
 #include "tests/raster_test_util.h"
@@ -467,6 +468,28 @@ TEST_CASE("frame: tiles no draw reaches hold the resolved clear value and are ha
             resolve_to_srgb8(fb.color.data(), W, H, 1.0f, ToneMap::Aces, whole.data());
             CHECK(tiles == whole);
         }
+}
+
+TEST_CASE("stream_fill: the bytes of a plain fill at any alignment and length, and nothing around them") {
+    // The fill of untouched tiles and their 8-bit output: non-temporal 32-byte
+    // stores in the middle, plain bytes at both ends.
+    const unsigned char pattern[16] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
+    int wrong = 0, cases = 0;
+    for (std::size_t size : {std::size_t(4), std::size_t(16)})
+        for (std::size_t offset = 0; offset < 40; ++offset)
+            for (std::size_t bytes = 0; bytes < 200; bytes += size) {
+                alignas(64) unsigned char got[320];
+                unsigned char want[320];
+                std::memset(got, 0xAB, sizeof got);
+                std::memset(want, 0xAB, sizeof want);
+                for (std::size_t i = 0; i < bytes; ++i) want[64 + offset + i] = pattern[i % size];
+                stream_fill(got + 64 + offset, bytes, StreamPattern(pattern, size));
+                stream_fence();
+                wrong += std::memcmp(got, want, sizeof got) != 0;
+                ++cases;
+            }
+    CHECK(cases == 40 * (50 + 13));  // lengths 0..196 by 4 and 0..192 by 16, 40 offsets each
+    CHECK(wrong == 0);
 }
 
 TEST_CASE("frame: misuse is refused") {
