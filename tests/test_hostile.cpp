@@ -516,8 +516,12 @@ TEST_CASE("a truncated run-length .hdr (CVE-2021-42715 in stb_image 2.27) is ref
     CHECK(has_line_with(r.err, "t.hdr: cannot decode HDR image: truncated pixel data", "(texture ignored)"));
 }
 
-TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused before stb_image reads it") {
-    // A valid baseline JPEG, then the same with one DHT count raised.
+namespace {
+
+// A valid 16x16 baseline JPEG (stb_image_write, quality 90) and the offset
+// of its first Huffman table segment (DHT), whose 16 code counts start 5
+// bytes in.
+std::vector<unsigned char> small_jpeg(std::size_t& dht) {
     std::vector<unsigned char> jpg;
     std::vector<unsigned char> px(16 * 16 * 3, 0);
     for (std::size_t i = 0; i < px.size(); ++i) px[i] = (unsigned char)(i * 7);
@@ -527,6 +531,21 @@ TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused be
             o->insert(o->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
         },
         &jpg, 16, 16, 3, px.data(), 90);
+    dht = 0;
+    for (std::size_t i = 0; i + 1 < jpg.size(); ++i)
+        if (jpg[i] == 0xFF && jpg[i + 1] == 0xC4) {
+            dht = i;
+            break;
+        }
+    return jpg;
+}
+
+} // namespace
+
+TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused before stb_image reads it") {
+    // A valid baseline JPEG, then the same with one DHT count raised.
+    std::size_t dht = 0;
+    const std::vector<unsigned char> jpg = small_jpeg(dht);
     REQUIRE(looks_like_jpeg(jpg.data(), jpg.size()));
     CHECK(check_jpeg_data(jpg.data(), jpg.size()) == "");
     ImageSource src;
@@ -534,9 +553,6 @@ TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused be
     src.bytes = jpg;
     CHECK(decode_image(src, true).width == 16);
 
-    std::size_t dht = 0;
-    for (std::size_t i = 0; i + 1 < jpg.size(); ++i)
-        if (jpg[i] == 0xFF && jpg[i + 1] == 0xC4) { dht = i; break; }
     REQUIRE(dht > 0);
     std::vector<unsigned char> bad = jpg;
     bad[dht + 5 + 15] = 255;  // the 16-bit code count of the first table
@@ -841,20 +857,10 @@ TEST_CASE("prast-diff on hostile and mismatched images: one line, exit 2, never 
     write_png(box.path("a.png"), 12, 8, 10, 20, 30);
     // A JPEG whose Huffman table overflows stb_image 2.27's (read through the
     // renderer's guard now, not by stb directly).
-    std::vector<unsigned char> jpg;
-    std::vector<unsigned char> px(16 * 16 * 3, 0);
-    for (std::size_t i = 0; i < px.size(); ++i) px[i] = (unsigned char)(i * 7);
-    stbi_write_jpg_to_func(
-        [](void* ctx, void* data, int size) {
-            auto* o = static_cast<std::vector<unsigned char>*>(ctx);
-            o->insert(o->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
-        },
-        &jpg, 16, 16, 3, px.data(), 90);
-    for (std::size_t i = 0; i + 1 < jpg.size(); ++i)
-        if (jpg[i] == 0xFF && jpg[i + 1] == 0xC4) {
-            jpg[i + 5 + 15] = 255;
-            break;
-        }
+    std::size_t dht = 0;
+    std::vector<unsigned char> jpg = small_jpeg(dht);
+    REQUIRE(dht > 0);
+    jpg[dht + 5 + 15] = 255;
     test::write_bytes(box.path("dht.jpg"), jpg);
     const std::string rows(17, '\0');
     test::write_bytes(box.path("huge.png"), bytes_of(kPngSignature + png_ihdr(16384, 16384, 8, 6) +
