@@ -33,6 +33,7 @@
 #include "apps/render_options.h"
 #include "raster/pipeline.h"
 #include "scene/camera.h"
+#include "scene/camera_request.h"
 #include "scene/default_scene.h"
 #include "scene/image.h"
 #include "scene/load_environment.h"
@@ -40,6 +41,7 @@
 #include "scene/messages.h"
 #include "scene/write_image.h"
 #include "shading/environment.h"
+#include "shading/memory_plan.h"
 #include "shading/scene_renderer.h"
 #include "shading/surface.h"
 #include "shading/tonemap.h"
@@ -188,125 +190,6 @@ std::string check_output_paths(const render_cli::FramePattern& pattern, int firs
     return "";
 }
 
-// The camera, checked before anything is drawn: every coordinate within
-// kMaxCameraCoordinate (beyond it the view matrix overflows single
-// precision), eye and target apart, up not along the view. The message blames
-// what is wrong: a flag (exit 2), or the scene's bounds when the framing came
-// from them (exit 1). "" when the camera can render.
-std::string check_camera(const Camera& cam, const RenderOptions& opt, const Bounds& bounds, bool framed,
-                         int& code) {
-    const auto fits = [](const glm::dvec3& v) {
-        return std::fabs(v.x) <= kMaxCameraCoordinate && std::fabs(v.y) <= kMaxCameraCoordinate &&
-               std::fabs(v.z) <= kMaxCameraCoordinate;
-    };
-    const auto vec = [](const glm::dvec3& v) {
-        char buf[96];
-        std::snprintf(buf, sizeof buf, "%g,%g,%g", v.x, v.y, v.z);
-        return std::string(buf);
-    };
-    const std::string scene = opt.scene;
-    const glm::dvec3 lo(bounds.lo), hi(bounds.hi);
-    const bool bounds_fit = bounds.empty() || (fits(lo) && fits(hi) && fits(hi - lo));
-    const std::string bounds_text = bounds.empty() ? "empty" : "from " + vec(lo) + " to " + vec(hi);
-    code = kExitBadFile;
-    if (framed && (!opt.eye || !opt.target) && !bounds_fit)
-        return scene + ": cannot frame the scene: its bounds (" + bounds_text +
-               ") reach beyond +-1e18, where single precision breaks down; give --eye and --target (and --near, --far)";
-    if (framed && (!opt.near_plane || !opt.far_plane) && !bounds_fit)
-        return scene + ": cannot fit clip planes to the scene: its bounds (" + bounds_text +
-               ") reach beyond +-1e18; give --near and --far";
-    const glm::dvec3 eye(cam.eye), target(cam.target);
-    if (!fits(eye) || !fits(target)) {
-        // Framing put the eye too far: the field of view was too narrow for the scene.
-        code = kExitUsage;
-        if (opt.fov_deg < 45.0f)
-            return "--fov " + std::to_string(opt.fov_deg) + ": framing the scene (bounds " + bounds_text +
-                   ") this narrowly puts the eye at " + vec(eye) + ", beyond +-1e18; give a wider --fov or --eye";
-        code = kExitBadFile;
-        return scene + ": cannot frame the scene: its bounds (" + bounds_text + ") put the eye at " + vec(eye) +
-               ", beyond +-1e18; give --eye and --target";
-    }
-    code = kExitUsage;
-    const glm::dvec3 view = target - eye;
-    if (!(glm::length(view) > 0.0)) {
-        if (opt.eye && opt.target) return "--eye/--target: the eye and the target are the same point";
-        if (opt.eye) return "--eye " + vec(eye) + ": the framed target (the scene's centre) is there too; give --target";
-        if (opt.target) return "--target " + vec(target) + ": the framed eye is there too; give --eye";
-        code = kExitBadFile;
-        return scene + ": cannot frame the scene: its bounds (" + bounds_text +
-               ") are too small for their distance from the origin in single precision";
-    }
-    const glm::dvec3 up = glm::dvec3(cam.up);
-    if (!(glm::length(glm::cross(glm::normalize(view), up)) > 1e-4)) {
-        if (opt.up) return "--up: parallel to the viewing direction (eye to target); give another --up";
-        return "--eye/--target: the view is vertical, along the default up 0,1,0; give --up";
-    }
-    return "";
-}
-
-// Bytes a render holds at its peak, estimated before the textures are decoded
-// or a frame drawn: the scene as loaded, the decoded textures with their mip
-// chains (the file's bytes per texel, 16 for float RGBA; 4/3 for the chain),
-// the pipeline's per-vertex and per-triangle work for the largest mesh, the
-// framebuffer and 8-bit image.
-struct MemoryPlan {
-    std::uint64_t scene = 0, textures = 0, pipeline = 0, image = 0;
-    std::uint64_t texels = 0;
-    std::size_t images = 0;
-    std::uint64_t total() const { return scene + textures + pipeline + image; }
-};
-
-constexpr std::uint64_t kPipelineBytesPerVertex = 96;             // clip position and varyings
-constexpr std::uint64_t kPipelineBytesPerTriangle = 96;           // set-up edges and bin entries
-
-MemoryPlan plan_memory(const Scene& scene, const RenderOptions& opt) {
-    MemoryPlan plan;
-    std::size_t max_vertices = 0, max_triangles = 0;
-    for (const Mesh& m : scene.meshes) {
-        plan.scene += m.positions.size() * sizeof(glm::vec3) + m.normals.size() * sizeof(glm::vec3) +
-                      m.uvs.size() * sizeof(glm::vec2) + m.tangents.size() * sizeof(glm::vec4) +
-                      m.indices.size() * sizeof(std::uint32_t);
-        max_vertices = std::max(max_vertices, m.positions.size());
-        max_triangles = std::max(max_triangles, m.indices.size() / 3);
-    }
-    plan.pipeline = max_vertices * kPipelineBytesPerVertex + max_triangles * kPipelineBytesPerTriangle;
-    // Each (image, colour space) a material uses is one texture.
-    std::set<std::pair<int, bool>> used;
-    for (const Material& m : scene.materials) {
-        for (const TextureRef* r : {&m.base_color, &m.emissive}) used.insert({r->image, true});
-        for (const TextureRef* r : {&m.metallic_roughness, &m.roughness, &m.metallic, &m.normal, &m.occlusion})
-            used.insert({r->image, false});
-    }
-    std::vector<int> per_image(scene.images.size(), 0);
-    for (const auto& u : used)
-        if (u.first >= 0 && std::size_t(u.first) < scene.images.size()) ++per_image[std::size_t(u.first)];
-    for (std::size_t i = 0; i < scene.images.size(); ++i) {
-        if (per_image[i] == 0) continue;
-        int w = 0, h = 0, texel_bytes = 16;
-        const ImageSource& src = scene.images[i];
-        if (src.decoded) {
-            w = src.decoded->width;
-            h = src.decoded->height;
-            texel_bytes = src.decoded->is_8bit() ? src.decoded->channels : 16;
-        } else if (!image_dimensions(src, w, h, &texel_bytes)) {
-            continue;  // decoding will fail and say why
-        }
-        const std::uint64_t texels = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(per_image[i]);
-        plan.texels += texels;
-        plan.textures += texels * std::uint64_t(texel_bytes) * 4 / 3;
-        ++plan.images;
-    }
-    plan.image = std::uint64_t(opt.width) * std::uint64_t(opt.height) * kBytesPerPixel;
-    return plan;
-}
-
-// v rotated by `radians` around the unit axis k (Rodrigues), in double so the
-// eye of frame i does not depend on which frames were rendered before it.
-glm::vec3 rotate_around(const glm::vec3& v, const glm::vec3& k, double radians) {
-    const glm::dvec3 dv(v), dk(k);
-    const double c = std::cos(radians), s = std::sin(radians);
-    return glm::vec3(dv * c + glm::cross(dk, dv) * s + dk * glm::dot(dk, dv) * (1.0 - c));
-}
 
 // The nearest triangle along pixel (x, y)'s ray, for --pixel: a brute-force
 // ray cast (Moller-Trumbore) over the scene, with the rasterizer's culling.
@@ -513,30 +396,37 @@ int run(int argc, char** argv) {
     // single fields, and the framing fills in the rest.
     const Bounds bounds = scene.bounds();
     const float aspect = float(opt.width) / float(opt.height);
-    const bool framed = !opt.scene.empty();
-    if (framed) camera = frame_bounds(bounds, opt.fov_deg, aspect);
-    camera.fov_y_deg = opt.fov_deg;
-    if (opt.eye) camera.eye = *opt.eye;
-    if (opt.target) camera.target = *opt.target;
-    if (opt.up) camera.up = glm::vec3(glm::normalize(glm::dvec3(*opt.up)));
-    int camera_code = 0;
-    const std::string camera_err = check_camera(camera, opt, bounds, framed, camera_code);
-    if (!camera_err.empty()) return fail(camera_code, camera_err);
+    const CameraRequest camera_request = opt.camera_request();
+    if (CameraFault f = request_camera(camera_request, bounds, aspect, !opt.scene.empty(), camera, camera))
+        return fail(f.kind == CameraFault::Flag ? kExitUsage : kExitBadFile, f.message);
+
+    // The environment: --env (its size read from the header), or the scene's
+    // own (the built-in sky).
+    int env_w = scene.environment ? scene.environment->width : 0;
+    int env_h = scene.environment ? scene.environment->height : 0;
+    if (!opt.env.empty()) {
+        ImageSource env_source;
+        env_source.path = env_source.name = opt.env;
+        if (!image_dimensions(env_source, env_w, env_h)) env_w = env_h = 0;  // decoding will say why
+    }
 
     // The whole render must fit in memory before anything big is allocated.
     g_stage = "planning memory";
-    const MemoryPlan plan = plan_memory(scene, opt);
-    const std::uint64_t budget = render_memory_budget();
+    MemoryPlan plan = plan_memory(scene, opt.width, opt.height, kBytesPerPixel);
+    plan_environment(plan, env_w, env_h, opt.env);
+    // Lights: the scene's and the flags'; the default rig only when neither has
+    // any and no environment lights the scene.
+    const bool has_environment = scene.environment || !opt.env.empty();
+    FrameSettings settings;
+    bool used_default_rig = false;
+    settings.lights = frame_lights(scene, opt.lights, opt.no_default_lights, has_environment, used_default_rig);
+    plan_shadows(plan, settings.lights, opt.shadows);
+    const std::uint64_t budget = memory_budget();
     if (plan.total() > budget)
-        return fail(kExitBadFile,
-                    (opt.scene.empty() ? std::string("the built-in scene") : opt.scene) + ": the render needs about " +
-                        std::to_string(plan.total()) + " bytes (scene " + std::to_string(plan.scene) + ", textures " +
-                        std::to_string(plan.textures) + " for " + std::to_string(plan.texels) + " texels in " +
-                        std::to_string(plan.images) + " images, drawing " + std::to_string(plan.pipeline) + ", image " +
-                        std::to_string(plan.image) + "), more than the " + std::to_string(budget) +
-                        " bytes allowed (half the physical memory)");
+        return fail(kExitBadFile, (opt.scene.empty() ? std::string("the built-in scene") : opt.scene) +
+                                      ": the render needs " + plan.describe() + ", more than the " +
+                                      std::to_string(budget) + " bytes allowed (half the physical memory)");
 
-    // The environment: --env, or the scene's own (the built-in sky).
     std::shared_ptr<const Image> env_image = scene.environment;
     if (!opt.env.empty()) {
         try {
@@ -546,16 +436,9 @@ int run(int argc, char** argv) {
         }
     }
 
-    // Lights: the scene's and the flags'; the default rig only when neither has
-    // any and no environment lights the scene.
-    FrameSettings settings;
-    settings.lights = shading_lights(scene);
-    settings.lights.insert(settings.lights.end(), opt.lights.begin(), opt.lights.end());
-    if (settings.lights.empty() && !opt.no_default_lights && !env_image) {
-        settings.lights = default_light_rig();
+    if (used_default_rig)
         progress.note("render: no lights in the scene or flags: using the default key+fill rig "
                       "(--no-default-lights to disable)");
-    }
     if (env_image && opt.ambient_given)
         progress.note("render: warning: --ambient is not used: the environment map replaces the ambient term");
     settings.ambient = opt.ambient;
@@ -623,21 +506,12 @@ int run(int argc, char** argv) {
     out8.tonemap = opt.effective_tonemap();
     out8.raw = debug_view_is_data(opt.view);
     std::vector<double> frame_ms;
-    const glm::vec3 orbit_axis = glm::normalize(camera.up);
     int step = 2;
     for (int frame = opt.first_frame; frame <= opt.last_frame; ++frame) {
         // Frame i of a turntable sits at angle i * DEG / N around the target.
-        Camera cam = camera;
         const double angle = glm::radians(double(frame) * opt.orbit_deg / double(opt.frames));
-        cam.eye = camera.target + rotate_around(camera.eye - camera.target, orbit_axis, angle);
-        fit_clip_planes(cam, bounds);
-        if (opt.near_plane) cam.near_plane = *opt.near_plane;
-        if (opt.far_plane) cam.far_plane = *opt.far_plane;
-        if (!(cam.near_plane < cam.far_plane))
-            return fail(kExitUsage, "--near/--far: near " + std::to_string(cam.near_plane) +
-                                        " is not less than far " + std::to_string(cam.far_plane) +
-                                        " (give both --near and --far)");
-        settings.camera = cam;
+        if (CameraFault f = orbit_camera(camera_request, camera, bounds, angle, settings.camera))
+            return fail(kExitUsage, f.message);
 
         double render_ms = 0.0;
         for (int r = 0; r < opt.repeat; ++r) {
@@ -664,7 +538,7 @@ int run(int argc, char** argv) {
                         frame, renderer.stats().to_string().c_str(), render_ms, ms_since(t_write));
         }
         if (opt.pixel)
-            print_pixel(scene, cam, fb, rgba8, *opt.pixel, frame, scene_renderer, settings,
+            print_pixel(scene, settings.camera, fb, rgba8, *opt.pixel, frame, scene_renderer, settings,
                         opt.samples_given ? opt.ibl_samples : 4096);
         std::fflush(stdout);
     }

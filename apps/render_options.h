@@ -17,9 +17,11 @@
 #include <glm/glm.hpp>
 
 #include "raster/limits.h"
+#include "scene/camera_request.h"
 #include "shading/background.h"
 #include "shading/brdf.h"
 #include "shading/debug_view.h"
+#include "shading/memory_plan.h"
 #include "shading/surface.h"
 #include "shading/tonemap.h"
 
@@ -40,9 +42,6 @@ constexpr std::uint64_t kBytesPerPixel = kFramebufferBytesPerPixel + kImageBytes
 // Caps on counts that no sensible job exceeds; they keep a typo (an extra
 // zero) from starting a job that runs for days.
 constexpr int kMaxThreads = 1024;
-// Camera coordinates beyond this leave single precision no room: the view
-// matrix squares distances (1e19 squared overflows a float).
-constexpr double kMaxCameraCoordinate = 1e18;
 // Below this field of view the framing distance explodes (r / sin(fov / 2)).
 constexpr double kMinFovDeg = 0.001;
 constexpr long kMaxFrames = 1000000;
@@ -99,6 +98,8 @@ struct RenderOptions {
     bool help = false, version = false;
 
     bool hdr_output() const;
+    // What the flags say about the camera (scene/camera_request.h).
+    CameraRequest camera_request() const { return {scene, eye, target, up, fov_deg, near_plane, far_plane}; }
     ToneMap effective_tonemap() const {
         return tonemap_given || view == DebugView::None ? tonemap : ToneMap::None;
     }
@@ -246,13 +247,6 @@ private:
 
 inline bool RenderOptions::hdr_output() const { return render_cli::ends_with(render_cli::lower(output), ".hdr"); }
 
-// Half the physical memory: the most a render may plan to use for its images.
-inline std::uint64_t render_memory_budget() {
-    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || page <= 0) return std::uint64_t(4) << 30;  // unknown: assume 8 GiB of RAM
-    return std::uint64_t(pages) * std::uint64_t(page) / 2;
-}
-
 // "" when a w x h image fits; otherwise the reason, with the bytes it needs.
 inline std::string check_image_size(long w, long h, std::uint64_t budget_bytes) {
     const std::string size = std::to_string(w) + "x" + std::to_string(h);
@@ -274,7 +268,7 @@ inline std::string check_image_size(long w, long h, std::uint64_t budget_bytes) 
 // error, exit code 2. --help and --version stop the parse with out.help /
 // out.version set.
 inline std::string parse_render_args(int argc, const char* const* argv, RenderOptions& out,
-                                     std::uint64_t memory_budget = render_memory_budget()) {
+                                     std::uint64_t memory_budget = prast::memory_budget()) {
     using namespace render_cli;
     bool frames_given = false, only_positional = false;
     std::string range_text;

@@ -165,6 +165,7 @@ int run(int argc, char** argv) {
     req.tile_size = opt.tile_size;
     req.samples = opt.msaa;
     req.shadows = opt.shadows;
+    req.bytes_per_pixel = kBytesPerPixel;
 
     StepScene scene;
     SetupError setup_err;

@@ -9,11 +9,12 @@
 # Builds build-fuzz/ with clang (apt-get install clang libclang-rt-14-dev),
 # writes the project's seed corpora (fuzz/make_seeds.cpp) to build-fuzz/seeds,
 # adds tests/fuzz-regressions/HARNESS as seeds, keeps the growing corpus in
-# build-fuzz/corpus/HARNESS and any crash, hang (-timeout 10 s) or allocation
+# build-fuzz/corpus/HARNESS and any crash, hang (-timeout, 10 s) or allocation
 # over 2 GB (-rss_limit_mb) in build-fuzz/findings/HARNESS. The last line of
 # each harness's log (build-fuzz/fuzz-HARNESS.log) gives executions and
 # coverage (cov: edges, ft: features). Exit status 1 when a harness found
-# something.
+# something. FUZZ_TIMEOUT (seconds, default 10) is the per-input hang limit:
+# raise it on a machine shared with other jobs, where a slow input is not a hang.
 set -e
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
@@ -42,7 +43,7 @@ for h in $harnesses; do
   [ -d tests/fuzz-regressions/$h ] && extra="$PWD/tests/fuzz-regressions/$h"
   echo "==== fuzz_$h for $seconds s"
   # shellcheck disable=SC2086
-  if ! $out/fuzz/fuzz_$h -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  if ! $out/fuzz/fuzz_$h -max_total_time="$seconds" -timeout="${FUZZ_TIMEOUT:-10}" -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix=$out/findings/$h/ $out/corpus/$h $out/seeds/$h $extra >$out/fuzz-$h.log 2>&1; then
     status=1
     echo "fuzz_$h: FINDING, see $out/fuzz-$h.log and $out/findings/$h/"

@@ -29,6 +29,7 @@
 #endif
 
 #include "raster/limits.h"
+#include "shading/simd.h"
 #include "shading/texture.h"
 
 namespace prast {
@@ -202,63 +203,6 @@ inline void fetch_lanes_one_by_one(const Texture* const* tex, int count, const T
 }
 
 #ifdef __AVX2__
-
-// W lanes per instruction: 8 (ymm) or 4 (xmm).
-template <int W> struct Simd;
-
-template <> struct Simd<8> {
-    using F = __m256;
-    using I = __m256i;
-    static I load_i(const std::int32_t* p) { return _mm256_load_si256(reinterpret_cast<const __m256i*>(p)); }
-    static F load_f(const float* p) { return _mm256_load_ps(p); }
-    static void store_f(float* p, F v) { _mm256_store_ps(p, v); }
-    static I set1_i(int v) { return _mm256_set1_epi32(v); }
-    static F set1_f(float v) { return _mm256_set1_ps(v); }
-    static F zero_f() { return _mm256_setzero_ps(); }
-    static I lane_bits() { return _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128); }
-    template <int Scale> static I gather_i(const std::uint8_t* base, I idx) {
-        return _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale);
-    }
-    static F gather_f(const float* table, I idx) { return _mm256_i32gather_ps(table, idx, 4); }
-    static I add_i(I a, I b) { return _mm256_add_epi32(a, b); }
-    static I and_i(I a, I b) { return _mm256_and_si256(a, b); }
-    static I srlv_i(I a, I n) { return _mm256_srlv_epi32(a, n); }
-    static I cmpeq_i(I a, I b) { return _mm256_cmpeq_epi32(a, b); }
-    static F cvt(I a) { return _mm256_cvtepi32_ps(a); }
-    static F add(F a, F b) { return _mm256_add_ps(a, b); }
-    static F sub(F a, F b) { return _mm256_sub_ps(a, b); }
-    static F mul(F a, F b) { return _mm256_mul_ps(a, b); }
-    static F div(F a, F b) { return _mm256_div_ps(a, b); }
-    static F select(F mask, F yes, F no) { return _mm256_blendv_ps(no, yes, mask); }
-    static F as_f(I a) { return _mm256_castsi256_ps(a); }
-};
-
-template <> struct Simd<4> {
-    using F = __m128;
-    using I = __m128i;
-    static I load_i(const std::int32_t* p) { return _mm_load_si128(reinterpret_cast<const __m128i*>(p)); }
-    static F load_f(const float* p) { return _mm_load_ps(p); }
-    static void store_f(float* p, F v) { _mm_store_ps(p, v); }
-    static I set1_i(int v) { return _mm_set1_epi32(v); }
-    static F set1_f(float v) { return _mm_set1_ps(v); }
-    static F zero_f() { return _mm_setzero_ps(); }
-    static I lane_bits() { return _mm_setr_epi32(1, 2, 4, 8); }
-    template <int Scale> static I gather_i(const std::uint8_t* base, I idx) {
-        return _mm_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale);
-    }
-    static F gather_f(const float* table, I idx) { return _mm_i32gather_ps(table, idx, 4); }
-    static I add_i(I a, I b) { return _mm_add_epi32(a, b); }
-    static I and_i(I a, I b) { return _mm_and_si128(a, b); }
-    static I srlv_i(I a, I n) { return _mm_srlv_epi32(a, n); }
-    static I cmpeq_i(I a, I b) { return _mm_cmpeq_epi32(a, b); }
-    static F cvt(I a) { return _mm_cvtepi32_ps(a); }
-    static F add(F a, F b) { return _mm_add_ps(a, b); }
-    static F sub(F a, F b) { return _mm_sub_ps(a, b); }
-    static F mul(F a, F b) { return _mm_mul_ps(a, b); }
-    static F div(F a, F b) { return _mm_div_ps(a, b); }
-    static F select(F mask, F yes, F no) { return _mm_blendv_ps(no, yes, mask); }
-    static F as_f(I a) { return _mm_castsi128_ps(a); }
-};
 
 // The packed bytes of texel idx (C bytes each, 4 read) for W lanes.
 template <class V, int C>

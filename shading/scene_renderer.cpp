@@ -35,6 +35,15 @@ std::vector<ShadingLight> default_light_rig() {
     return {key, fill};
 }
 
+std::vector<ShadingLight> frame_lights(const Scene& scene, const std::vector<ShadingLight>& flag_lights,
+                                       bool no_default_lights, bool environment, bool& used_default_rig) {
+    std::vector<ShadingLight> lights = shading_lights(scene);
+    lights.insert(lights.end(), flag_lights.begin(), flag_lights.end());
+    used_default_rig = lights.empty() && !no_default_lights && !environment;
+    if (used_default_rig) lights = default_light_rig();
+    return lights;
+}
+
 SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(scene), renderer_(renderer) {
     // Which (image, colour space) pairs the materials need, slot image * 2 + srgb.
     const std::size_t n_images = scene.images.size();

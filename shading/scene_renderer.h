@@ -61,6 +61,12 @@ std::vector<ShadingLight> shading_lights(const Scene& scene);
 // upper left front and a weaker, cooler fill from the right.
 std::vector<ShadingLight> default_light_rig();
 
+// The lights of a frame: the scene's, then the flags', and the default rig
+// when neither has any, none was refused (--no-default-lights) and no
+// environment lights the scene; `used_default_rig` says whether it was.
+std::vector<ShadingLight> frame_lights(const Scene& scene, const std::vector<ShadingLight>& flag_lights,
+                                       bool no_default_lights, bool environment, bool& used_default_rig);
+
 class SceneRenderer {
 public:
     // Decodes every texture the materials use. A texture that cannot be

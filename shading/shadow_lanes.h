@@ -12,14 +12,48 @@
 #include <cstdint>
 #include <type_traits>
 
-#ifdef __AVX2__
-#include <immintrin.h>
-#endif
 
 #include "raster/limits.h"
 #include "shading/shadow_map.h"
+#include "shading/simd.h"
 
 namespace prast {
+
+#ifdef __AVX2__
+// W = V's width lanes of shadow_pcf(), a gather per tap: first the least and
+// greatest distance of each lane's footprint cell, which settle lanes all lit
+// (1) or all in shadow (0); the 16 taps only when a lane is in a penumbra.
+template <class V>
+inline void shadow_pcf_group(const ShadowMap& map, const std::int32_t* base, const std::int32_t* cell,
+                             const float* fx, const float* fy, const float* thr, float* vis) {
+    using F = typename V::F;
+    const F one = V::set1_f(1.0f), zero = V::zero_f();
+    const typename V::I c = V::load_i(cell);
+    const F th = V::load_f(thr);
+    const F lit_all = V::cmpge(V::gather_f(map.cell_min.data(), c), th);
+    const F dark_all = V::cmplt(V::gather_f(map.cell_max.data(), c), th);
+    if (V::all(V::or_f(lit_all, dark_all))) {
+        V::store_f(vis, V::and_f(lit_all, one));
+        return;
+    }
+    const typename V::I b = V::load_i(base);
+    const F fxv = V::load_f(fx), fyv = V::load_f(fy);
+    const F wx[4] = {V::sub(one, fxv), one, one, fxv};
+    const F wy[4] = {V::sub(one, fyv), one, one, fyv};
+    const F sx = V::add(V::add(V::add(wx[0], wx[1]), wx[2]), wx[3]);
+    F lit = zero, total = zero;
+    for (int j = 0; j < 4; ++j) {
+        F rs = zero;
+        for (int i = 0; i < 4; ++i) {
+            const F d = V::gather_f(map.distance.data(), V::add_i(b, V::set1_i(j * map.stride + i)));
+            rs = V::add(rs, V::and_f(V::cmpge(d, th), wx[i]));
+        }
+        lit = V::add(lit, V::mul(wy[j], rs));
+        total = V::add(total, V::mul(wy[j], sx));
+    }
+    V::store_f(vis, V::div(lit, total));
+}
+#endif
 
 // vis[l] = the visibility of receiver l (positions P, geometric normals G,
 // unit, facing the viewer) from the light of `map`; l_dir is the direction
@@ -45,68 +79,11 @@ inline void shadow_visibility_lanes(const ShadowMap& map, const float* __restric
     };
     if (map.cube) taps(std::true_type{});
     else taps(std::false_type{});
-    const float* texels = map.distance.data();
-    const int stride = map.stride;
 #ifdef __AVX2__
-    const float* cmin = map.cell_min.data();
-    const float* cmax = map.cell_max.data();
     if constexpr (N >= 8) {
-        const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
-        for (int h = 0; h < N; h += 8) {
-            const __m256i c = _mm256_load_si256(reinterpret_cast<const __m256i*>(cell + h));
-            const __m256 th = _mm256_load_ps(thr + h);
-            // Footprints all lit or all in shadow: 1 or 0, what the PCF gives.
-            const __m256 lit_all = _mm256_cmp_ps(_mm256_i32gather_ps(cmin, c, 4), th, _CMP_GE_OQ);
-            const __m256 dark_all = _mm256_cmp_ps(_mm256_i32gather_ps(cmax, c, 4), th, _CMP_LT_OQ);
-            if (_mm256_movemask_ps(_mm256_or_ps(lit_all, dark_all)) == 0xFF) {
-                _mm256_store_ps(vis + h, _mm256_and_ps(lit_all, one));
-                continue;
-            }
-            const __m256i b = _mm256_load_si256(reinterpret_cast<const __m256i*>(base + h));
-            const __m256 fxv = _mm256_load_ps(fx + h), fyv = _mm256_load_ps(fy + h);
-            const __m256 wx[4] = {_mm256_sub_ps(one, fxv), one, one, fxv};
-            const __m256 wy[4] = {_mm256_sub_ps(one, fyv), one, one, fyv};
-            const __m256 sx = _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(wx[0], wx[1]), wx[2]), wx[3]);
-            __m256 lit = zero, total = zero;
-            for (int j = 0; j < 4; ++j) {
-                __m256 rs = zero;
-                for (int i = 0; i < 4; ++i) {
-                    const __m256i idx = _mm256_add_epi32(b, _mm256_set1_epi32(j * stride + i));
-                    const __m256 d = _mm256_i32gather_ps(texels, idx, 4);
-                    rs = _mm256_add_ps(rs, _mm256_and_ps(_mm256_cmp_ps(d, th, _CMP_GE_OQ), wx[i]));
-                }
-                lit = _mm256_add_ps(lit, _mm256_mul_ps(wy[j], rs));
-                total = _mm256_add_ps(total, _mm256_mul_ps(wy[j], sx));
-            }
-            _mm256_store_ps(vis + h, _mm256_div_ps(lit, total));
-        }
+        for (int h = 0; h < N; h += 8) shadow_pcf_group<Simd<8>>(map, base + h, cell + h, fx + h, fy + h, thr + h, vis + h);
     } else {
-        const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
-        const __m128i c = _mm_load_si128(reinterpret_cast<const __m128i*>(cell));
-        const __m128 th = _mm_load_ps(thr);
-        const __m128 lit_all = _mm_cmp_ps(_mm_i32gather_ps(cmin, c, 4), th, _CMP_GE_OQ);
-        const __m128 dark_all = _mm_cmp_ps(_mm_i32gather_ps(cmax, c, 4), th, _CMP_LT_OQ);
-        if (_mm_movemask_ps(_mm_or_ps(lit_all, dark_all)) == 0xF) {
-            _mm_store_ps(vis, _mm_and_ps(lit_all, one));
-            return;
-        }
-        const __m128i b = _mm_load_si128(reinterpret_cast<const __m128i*>(base));
-        const __m128 fxv = _mm_load_ps(fx), fyv = _mm_load_ps(fy);
-        const __m128 wx[4] = {_mm_sub_ps(one, fxv), one, one, fxv};
-        const __m128 wy[4] = {_mm_sub_ps(one, fyv), one, one, fyv};
-        const __m128 sx = _mm_add_ps(_mm_add_ps(_mm_add_ps(wx[0], wx[1]), wx[2]), wx[3]);
-        __m128 lit = zero, total = zero;
-        for (int j = 0; j < 4; ++j) {
-            __m128 rs = zero;
-            for (int i = 0; i < 4; ++i) {
-                const __m128i idx = _mm_add_epi32(b, _mm_set1_epi32(j * stride + i));
-                const __m128 d = _mm_i32gather_ps(texels, idx, 4);
-                rs = _mm_add_ps(rs, _mm_and_ps(_mm_cmp_ps(d, th, _CMP_GE_OQ), wx[i]));
-            }
-            lit = _mm_add_ps(lit, _mm_mul_ps(wy[j], rs));
-            total = _mm_add_ps(total, _mm_mul_ps(wy[j], sx));
-        }
-        _mm_store_ps(vis, _mm_div_ps(lit, total));
+        shadow_pcf_group<Simd<4>>(map, base, cell, fx, fy, thr, vis);
     }
 #else
     for (int l = 0; l < N; ++l) {
@@ -117,8 +94,6 @@ inline void shadow_visibility_lanes(const ShadowMap& map, const float* __restric
         t.threshold = thr[l];
         vis[l] = shadow_pcf(map, t);
     }
-    (void)texels;
-    (void)stride;
     (void)cell;
 #endif
 }

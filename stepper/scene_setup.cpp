@@ -3,27 +3,15 @@
 // floats are the same.
 #include "stepper/scene_setup.h"
 
-#include <cmath>
-
 #include "scene/camera.h"
+#include "scene/camera_request.h"
 #include "scene/default_scene.h"
 #include "scene/image.h"
 #include "scene/load_environment.h"
 #include "scene/load_scene.h"
+#include "shading/memory_plan.h"
 
 namespace prast::stepper {
-
-namespace {
-
-// render's turntable rotation (Rodrigues, in double): frame 0 turns by 0
-// radians, which still rounds eye - target through float and back.
-glm::vec3 rotate_around(const glm::vec3& v, const glm::vec3& k, double radians) {
-    const glm::dvec3 dv(v), dk(k);
-    const double c = std::cos(radians), s = std::sin(radians);
-    return glm::vec3(dv * c + glm::cross(dk, dv) * s + dk * glm::dot(dk, dv) * (1.0 - c));
-}
-
-} // namespace
 
 bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     out.options = opt;
@@ -45,18 +33,41 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     // Camera: the default scene's own, or framed on the bounds; flags override.
     const Bounds bounds = out.scene.bounds();
     const float aspect = float(opt.width) / float(opt.height);
-    if (!opt.scene.empty()) camera = frame_bounds(bounds, opt.fov_deg, aspect);
-    camera.fov_y_deg = opt.fov_deg;
-    if (opt.eye) camera.eye = *opt.eye;
-    if (opt.target) camera.target = *opt.target;
-    if (opt.up) camera.up = glm::normalize(*opt.up);
-    const glm::vec3 view_dir = camera.target - camera.eye;
-    if (!(glm::length(view_dir) > 0.0f)) {
-        err = {2, "--eye/--target: the eye and the target are the same point"};
+    const CameraRequest camera_request{opt.scene, opt.eye, opt.target, opt.up, opt.fov_deg, opt.near_plane,
+                                       opt.far_plane};
+    if (CameraFault f = request_camera(camera_request, bounds, aspect, !opt.scene.empty(), camera, camera)) {
+        err = {f.kind == CameraFault::Flag ? 2 : 1, f.message};
         return false;
     }
-    if (!(glm::length(glm::cross(glm::normalize(view_dir), camera.up)) > 1e-4f)) {
-        err = {2, "--up: parallel to the viewing direction (eye to target); give another --up"};
+
+    // The environment's size (--env's header, or the scene's own map) and
+    // the lights, for the memory plan.
+    int env_w = out.scene.environment ? out.scene.environment->width : 0;
+    int env_h = out.scene.environment ? out.scene.environment->height : 0;
+    if (!opt.env.empty()) {
+        ImageSource env_source;
+        env_source.path = env_source.name = opt.env;
+        if (!image_dimensions(env_source, env_w, env_h)) env_w = env_h = 0;  // decoding will say why
+    }
+    FrameSettings& s = out.settings;
+    bool used_default_rig = false;
+    s.lights = frame_lights(out.scene, opt.lights, opt.no_default_lights,
+                            out.scene.environment || !opt.env.empty(), used_default_rig);
+    if (used_default_rig)
+        out.notes.push_back("no lights in the scene or flags: using the default key+fill rig "
+                            "(--no-default-lights to disable)");
+
+    // render's memory plan, plus the recording: refused before anything big
+    // is allocated.
+    MemoryPlan plan = plan_memory(out.scene, opt.width, opt.height, opt.bytes_per_pixel);
+    plan_environment(plan, env_w, env_h, opt.env);
+    plan_shadows(plan, s.lights, opt.shadows);
+    plan_recording(plan, out.scene, opt.width, opt.height, opt.samples);
+    const std::uint64_t budget = opt.memory_budget ? opt.memory_budget : memory_budget();
+    if (plan.total() > budget) {
+        err = {1, (opt.scene.empty() ? std::string("the built-in scene") : opt.scene) + ": recording the frame needs " +
+                      plan.describe() + ", more than the " + std::to_string(budget) +
+                      " bytes allowed (half the physical memory)"};
         return false;
     }
 
@@ -71,16 +82,6 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
         }
     }
 
-    // Lights: the scene's and the flags'; the default rig only when neither
-    // has any and no environment lights the scene.
-    FrameSettings& s = out.settings;
-    s.lights = shading_lights(out.scene);
-    s.lights.insert(s.lights.end(), opt.lights.begin(), opt.lights.end());
-    if (s.lights.empty() && !opt.no_default_lights && !env_image) {
-        s.lights = default_light_rig();
-        out.notes.push_back("no lights in the scene or flags: using the default key+fill rig "
-                            "(--no-default-lights to disable)");
-    }
     s.ambient = opt.ambient;
     s.model = opt.brdf;
     s.view = DebugView::None;
@@ -91,17 +92,10 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     s.shadows = opt.shadows;
 
     // Frame 0 of render's turntable loop.
-    Camera cam = camera;
-    cam.eye = camera.target + rotate_around(camera.eye - camera.target, glm::normalize(camera.up), 0.0);
-    fit_clip_planes(cam, bounds);
-    if (opt.near_plane) cam.near_plane = *opt.near_plane;
-    if (opt.far_plane) cam.far_plane = *opt.far_plane;
-    if (!(cam.near_plane < cam.far_plane)) {
-        err = {2, "--near/--far: near " + std::to_string(cam.near_plane) + " is not less than far " +
-                      std::to_string(cam.far_plane) + " (give both --near and --far)"};
+    if (CameraFault f = orbit_camera(camera_request, camera, bounds, 0.0, s.camera)) {
+        err = {2, f.message};
         return false;
     }
-    s.camera = cam;
 
     RendererOptions ro;
     ro.threads = opt.threads;

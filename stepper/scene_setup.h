@@ -4,6 +4,7 @@
 // (tests/test_step.cpp) compare the two executables' outputs pixel by pixel.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -41,6 +42,8 @@ struct FrameRequest {
     int tile_size = kDefaultTileSize;
     int samples = 1;                         // per pixel (render's --msaa)
     ShadowSettings shadows;                  // render's --shadows, --shadow-size
+    std::uint64_t bytes_per_pixel = 24;      // render's framebuffer and image per pixel
+    std::uint64_t memory_budget = 0;         // 0: half the physical memory
 };
 
 // A scene ready to draw: loaded, framed, lit, its textures bound.

@@ -516,8 +516,12 @@ TEST_CASE("a truncated run-length .hdr (CVE-2021-42715 in stb_image 2.27) is ref
     CHECK(has_line_with(r.err, "t.hdr: cannot decode HDR image: truncated pixel data", "(texture ignored)"));
 }
 
-TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused before stb_image reads it") {
-    // A valid baseline JPEG, then the same with one DHT count raised.
+namespace {
+
+// A valid 16x16 baseline JPEG (stb_image_write, quality 90) and the offset
+// of its first Huffman table segment (DHT), whose 16 code counts start 5
+// bytes in.
+std::vector<unsigned char> small_jpeg(std::size_t& dht) {
     std::vector<unsigned char> jpg;
     std::vector<unsigned char> px(16 * 16 * 3, 0);
     for (std::size_t i = 0; i < px.size(); ++i) px[i] = (unsigned char)(i * 7);
@@ -527,6 +531,21 @@ TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused be
             o->insert(o->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
         },
         &jpg, 16, 16, 3, px.data(), 90);
+    dht = 0;
+    for (std::size_t i = 0; i + 1 < jpg.size(); ++i)
+        if (jpg[i] == 0xFF && jpg[i + 1] == 0xC4) {
+            dht = i;
+            break;
+        }
+    return jpg;
+}
+
+} // namespace
+
+TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused before stb_image reads it") {
+    // A valid baseline JPEG, then the same with one DHT count raised.
+    std::size_t dht = 0;
+    const std::vector<unsigned char> jpg = small_jpeg(dht);
     REQUIRE(looks_like_jpeg(jpg.data(), jpg.size()));
     CHECK(check_jpeg_data(jpg.data(), jpg.size()) == "");
     ImageSource src;
@@ -534,9 +553,6 @@ TEST_CASE("a JPEG whose Huffman table declares more than 256 codes is refused be
     src.bytes = jpg;
     CHECK(decode_image(src, true).width == 16);
 
-    std::size_t dht = 0;
-    for (std::size_t i = 0; i + 1 < jpg.size(); ++i)
-        if (jpg[i] == 0xFF && jpg[i + 1] == 0xC4) { dht = i; break; }
     REQUIRE(dht > 0);
     std::vector<unsigned char> bad = jpg;
     bad[dht + 5 + 15] = 255;  // the 16-bit code count of the first table
@@ -841,20 +857,10 @@ TEST_CASE("prast-diff on hostile and mismatched images: one line, exit 2, never 
     write_png(box.path("a.png"), 12, 8, 10, 20, 30);
     // A JPEG whose Huffman table overflows stb_image 2.27's (read through the
     // renderer's guard now, not by stb directly).
-    std::vector<unsigned char> jpg;
-    std::vector<unsigned char> px(16 * 16 * 3, 0);
-    for (std::size_t i = 0; i < px.size(); ++i) px[i] = (unsigned char)(i * 7);
-    stbi_write_jpg_to_func(
-        [](void* ctx, void* data, int size) {
-            auto* o = static_cast<std::vector<unsigned char>*>(ctx);
-            o->insert(o->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
-        },
-        &jpg, 16, 16, 3, px.data(), 90);
-    for (std::size_t i = 0; i + 1 < jpg.size(); ++i)
-        if (jpg[i] == 0xFF && jpg[i + 1] == 0xC4) {
-            jpg[i + 5 + 15] = 255;
-            break;
-        }
+    std::size_t dht = 0;
+    std::vector<unsigned char> jpg = small_jpeg(dht);
+    REQUIRE(dht > 0);
+    jpg[dht + 5 + 15] = 255;
     test::write_bytes(box.path("dht.jpg"), jpg);
     const std::string rows(17, '\0');
     test::write_bytes(box.path("huge.png"), bytes_of(kPngSignature + png_ihdr(16384, 16384, 8, 6) +
@@ -1305,8 +1311,15 @@ TEST_CASE("a texture that does not fit in memory is named in its warning, not as
 
 // ---------------------------------------------------------------- coordinates
 
-TEST_CASE("absurd coordinates: the scene's bounds are blamed, or the flag that is wrong") {
+TEST_CASE("absurd coordinates: the scene's bounds are blamed, or the flag that is wrong; step says the same") {
     CliSandbox box;
+    // step takes render's camera (scene/camera_request.h): the same lines, its own prefix.
+    for (const std::string tool : {"render", "step"}) {
+    CAPTURE(tool);
+    const auto render = [&](const CliSandbox& b, const std::vector<std::string>& args) {
+        return tool == "render" ? ::render(b, args) : step(b, args);
+    };
+    const std::string p = tool + ": ";
     const std::pair<const char*, const char*> scenes[] = {
         {"far.obj", "v 1e19 0 0\nv 1e19 1 0\nv 1e19 0 1\nf 1 2 3\n"},
         {"huge.obj", "v -1e38 -1e38 0\nv 1e38 -1e38 0\nv 0 1e38 0\nf 1 2 3\n"},
@@ -1318,7 +1331,7 @@ TEST_CASE("absurd coordinates: the scene's bounds are blamed, or the flag that i
         const CliRun r = render(box, {name, "--size", "16x16"});
         CHECK(r.code == 1);
         CHECK(lines_of(r.err).size() == 1);
-        CHECK(r.err.find(std::string("render: ") + name + ": cannot frame the scene: its bounds (") == 0);
+        CHECK(r.err.find(p + name + ": cannot frame the scene: its bounds (") == 0);
         CHECK(r.err.find("same point") == std::string::npos);
     }
     // A node matrix of 1e38.
@@ -1327,40 +1340,93 @@ TEST_CASE("absurd coordinates: the scene's bounds are blamed, or the flag that i
     write_text(box.path("m.gltf"), g);
     CliRun r = render(box, {"m.gltf", "--size", "16x16"});
     CHECK(r.code == 1);
-    CHECK(r.err.find("render: m.gltf: cannot frame the scene: its bounds (") == 0);
+    CHECK(r.err.find(p + "m.gltf: cannot frame the scene: its bounds (") == 0);
     // With a camera but fitted clip planes: the bounds again, asking for --near/--far.
     r = render(box, {"huge.obj", "--size", "16x16", "--eye", "0,0,10", "--target", "0,0,0"});
     CHECK(r.code == 1);
     CHECK(r.err.find("give --near and --far") != std::string::npos);
     // And with everything given, it renders.
     r = render(box, {"huge.obj", "--size", "16x16", "--eye", "0,0,10", "--target", "0,0,0", "--near", "1", "--far",
-                     "100", "-o", "h.png"});
+                     "100"});
     CHECK(r.code == 0);
 
     // Flags beyond what single precision can take name themselves.
     write_text(box.path("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     r = render(box, {"t.obj", "--fov", "1e-30"});
     CHECK(r.code == 2);
-    CHECK(r.err == "render: --fov '1e-30': must be at least 0.001 and less than 180 degrees\n");
+    CHECK(r.err == p + "--fov '1e-30': must be at least 0.001 and less than 180 degrees\n");
     r = render(box, {"t.obj", "--eye", "0,0,1e21"});
     CHECK(r.code == 2);
-    CHECK(r.err == "render: --eye '0,0,1e21': coordinates beyond +-1e18 cannot be rendered in single precision\n");
+    CHECK(r.err == p + "--eye '0,0,1e21': coordinates beyond +-1e18 cannot be rendered in single precision\n");
     r = render(box, {"t.obj", "--target", "1e19,0,0"});
     CHECK(r.code == 2);
-    CHECK(r.err.find("render: --target '1e19,0,0'") == 0);
+    CHECK(r.err.find(p + "--target '1e19,0,0'") == 0);
     // A narrow field of view that pushes the framed eye out of range.
     write_text(box.path("big.obj"), "v -1e14 -1e14 0\nv 1e14 -1e14 0\nv 0 1e14 0\nf 1 2 3\n");
     r = render(box, {"big.obj", "--fov", "0.001", "--size", "16x16"});
     CHECK(r.code == 2);
-    CHECK(r.err.find("render: --fov 0.001000: framing the scene") == 0);
+    CHECK(r.err.find(p + "--fov 0.001000: framing the scene") == 0);
     // The eye on the framed target: --eye is blamed, not --up.
     r = render(box, {"t.obj", "--eye", "0.5,0.5,0", "--size", "16x16"});
     CHECK(r.code == 2);
-    CHECK(r.err.find("render: --eye ") == 0);
+    CHECK(r.err.find(p + "--eye ") == 0);
     // Looking straight down without --up: the camera flags, with a way out.
     r = render(box, {"t.obj", "--eye", "0,5,0", "--target", "0,0,0", "--size", "16x16"});
     CHECK(r.code == 2);
-    CHECK(r.err == "render: --eye/--target: the view is vertical, along the default up 0,1,0; give --up\n");
+    CHECK(r.err == p + "--eye/--target: the view is vertical, along the default up 0,1,0; give --up\n");
+    }
+}
+
+TEST_CASE("the memory plan counts shadow maps and step's recording, before anything is drawn") {
+    // Point lights with 8192-texel shadow cubes: 6 x 4100^2 x 8 bytes each,
+    // planned from the flags alone, so enough of them exceed any budget.
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    REQUIRE(pages > 0);
+    const double budget = double(pages) * double(page) / 2.0;
+    const double per_light = 6.0 * 4100.0 * 4100.0 * 8.0;
+    const int lights = int(budget / per_light) + 1;
+    if (lights > 200) {
+        MESSAGE("skipped: this machine has so much memory that " << lights << " shadowed lights would be needed");
+        return;
+    }
+    CliSandbox box;
+    write_text(box.path("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");  // no lights of its own
+    std::vector<std::string> args = {"t.obj", "--size", "16x16", "--shadows", "on", "--shadow-size", "8192"};
+    for (int i = 0; i < lights; ++i) args.insert(args.end(), {"--point", "0,2,0:1,1,1"});
+    CliRun r = render(box, with(args, {"-o", "o.png"}));
+    CHECK(r.code == 1);
+    CHECK(lines_of(r.err).size() == 1);
+    CHECK(r.err.find("render: t.obj: the render needs about ") == 0);
+    CHECK(r.err.find(", shadow maps " + std::to_string(std::uint64_t(lights) * 6 * 4100 * 4100 * 8) + ")") !=
+          std::string::npos);
+    CHECK(!fs::exists(box.path("o.png")));
+    r = step(box, with(args, {"--pixel", "8,8"}));
+    CHECK(r.code == 1);
+    CHECK(lines_of(r.err).size() == 1);
+    CHECK(r.err.find("step: t.obj: recording the frame needs about ") == 0);
+    CHECK(r.err.find(", recording ") != std::string::npos);
+    CHECK(r.out.empty());
+    // A single shadowed point light renders: the plan does not simply refuse shadows.
+    args.resize(7);
+    r = render(box, with(args, {"--point", "0,2,0:1,1,1", "--shadow-size", "512", "-o", "o.png"}));
+    CHECK(r.code == 0);
+}
+
+TEST_CASE("--env names a FIFO, a device or a directory: one line, never a hang") {
+    CliSandbox box;
+    REQUIRE(mkfifo(box.path("sky.hdr").c_str(), 0600) == 0);
+    fs::create_symlink("/dev/zero", box.work() / "zero.hdr");
+    for (const std::string tool : {"render", "step"}) {
+        CAPTURE(tool);
+        const std::vector<std::string> args = {"--size", "16x16", "--env", "sky.hdr", "--pixel", "8,8"};
+        CliRun r = tool == "render" ? render(box, with(args, {"-o", "o.png"})) : step(box, args);
+        CHECK(r.code == 1);
+        CHECK(r.err == tool + ": sky.hdr: not a regular file (a FIFO), not read\n");
+        r = tool == "render" ? render(box, {"--size", "16x16", "--env", "zero.hdr", "-o", "o.png"})
+                             : step(box, {"--size", "16x16", "--env", "zero.hdr"});
+        CHECK(r.code == 1);
+        CHECK(r.err == tool + ": zero.hdr: not a regular file (a character device), not read\n");
+    }
 }
 
 } // TEST_SUITE
