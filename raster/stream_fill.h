@@ -31,6 +31,7 @@ struct StreamPattern {
 // Writes `bytes` bytes at dst, the pattern repeated from dst on. Call
 // stream_fence() before other threads read the memory.
 inline void stream_fill(void* dst, std::size_t bytes, const StreamPattern& p) {
+    if (bytes == 0) return;  // dst may then be null (memcpy's arguments may not)
     auto* out = static_cast<unsigned char*>(dst);
 #if defined(__AVX2__)
     // Plain bytes up to a 32-byte boundary, whole 32-byte stores, plain bytes after.
