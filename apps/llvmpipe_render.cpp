@@ -44,6 +44,7 @@
 
 #include "apps/render_options.h"
 #include "scene/camera.h"
+#include "scene/camera_request.h"
 #include "scene/default_scene.h"
 #include "scene/image.h"
 #include "scene/load_scene.h"
@@ -367,17 +368,14 @@ int main(int argc, char** argv) {
     const double load_ms = ms_since(t_load);
     const Bounds bounds = scene.bounds();
     const float aspect = float(opt.width) / float(opt.height);
-    if (!opt.scene.empty()) camera = frame_bounds(bounds, opt.fov_deg, aspect);
-    camera.fov_y_deg = opt.fov_deg;
-    if (opt.eye) camera.eye = *opt.eye;
-    if (opt.target) camera.target = *opt.target;
-    if (opt.up) camera.up = glm::normalize(*opt.up);
-    fit_clip_planes(camera, bounds);
-    if (opt.near_plane) camera.near_plane = *opt.near_plane;
-    if (opt.far_plane) camera.far_plane = *opt.far_plane;
-    std::vector<ShadingLight> lights = shading_lights(scene);
-    lights.insert(lights.end(), opt.lights.begin(), opt.lights.end());
-    if (lights.empty() && !opt.no_default_lights) lights = default_light_rig();
+    const CameraRequest camera_request = opt.camera_request();
+    if (CameraFault f = request_camera(camera_request, bounds, aspect, !opt.scene.empty(), camera, camera))
+        die(f.message);
+    if (CameraFault f = orbit_camera(camera_request, camera, bounds, 0.0, camera)) die(f.message);
+    // No environment here: the default rig whenever render's would light a scene without an --env.
+    bool used_default_rig = false;
+    const std::vector<ShadingLight> lights =
+        frame_lights(scene, opt.lights, opt.no_default_lights, false, used_default_rig);
     if (lights.size() > 8) die("more than 8 lights");
 
     // A GL 3.3 core context. Its OSMesa window (client memory, copied there on

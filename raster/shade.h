@@ -31,6 +31,10 @@ struct TriangleVaryings {
 template <int NV>
 inline void prepare_varyings(const TriangleSetup& t, const float* vertices, const BinJob& job,
                              TriangleVaryings<NV>& p) {
+    if constexpr (NV == 0) {
+        p.v0[0] = p.d1[0] = p.d2[0] = 0.0f;  // never read; set so no compiler sees an uninitialised copy
+        return;
+    }
     constexpr int stride = 4 + NV;
     const float* v[3];
     for (int i = 0; i < 3; ++i) {
