@@ -393,28 +393,53 @@ struct FeatureOptions {
     float blend_alpha = -1.0f;         // >= 0: every material BLEND with this alpha
 };
 
+// A workload's scene (loaded, or the built-in one) and the frame settings
+// every measurement uses: its camera with fitted clip planes, its own lights
+// or one sun, ambient 0.05.
+struct LoadedWorkload {
+    DefaultScene builtin;
+    Scene loaded;
+    const Scene* scene = nullptr;
+    FrameSettings settings;
+};
+
+void load_workload(const Workload& w, int samples, LoadedWorkload& out) {
+    Camera cam;
+    if (w.file.empty()) {
+        out.builtin = make_default_scene();
+        out.scene = &out.builtin.scene;
+        cam = out.builtin.camera;
+    } else {
+        out.loaded = load_scene(w.file);
+        out.scene = &out.loaded;
+        cam.eye = w.eye;
+        cam.target = w.target;
+        cam.fov_y_deg = w.fov;
+    }
+    fit_clip_planes(cam, out.scene->bounds());
+    FrameSettings& fs = out.settings;
+    fs.camera = cam;
+    if (w.own_lights) {
+        fs.lights = shading_lights(*out.scene);
+    } else {
+        ShadingLight sun;
+        sun.direction = glm::normalize(glm::vec3(0.35f, 0.6f, 0.7f));
+        sun.radiance = glm::vec3(3.0f);
+        fs.lights = {sun};
+    }
+    fs.ambient = glm::vec3(0.05f);
+    fs.samples = samples;
+}
+
 Result measure(const Workload& w, int threads, int tile, int repeat, int width, int height, int samples,
                bool shadows, int shadow_size) {
     Result r;
     r.name = w.name;
     r.samples = samples;
     auto t_load = Clock::now();
-    DefaultScene builtin;
-    Scene loaded;
-    const Scene* scene;
-    Camera cam;
-    if (w.file.empty()) {
-        builtin = make_default_scene();
-        scene = &builtin.scene;
-        cam = builtin.camera;
-    } else {
-        loaded = load_scene(w.file);
-        scene = &loaded;
-        cam.eye = w.eye;
-        cam.target = w.target;
-        cam.fov_y_deg = w.fov;
-    }
-    fit_clip_planes(cam, scene->bounds());
+    LoadedWorkload lw;
+    load_workload(w, samples, lw);
+    const Scene* scene = lw.scene;
     r.load_ms = ms_since(t_load);
     r.triangles = scene->triangle_count();
 
@@ -431,18 +456,7 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
                 r.texture_bytes += t->memory_bytes();
             }
 
-    FrameSettings fs;
-    fs.camera = cam;
-    if (w.own_lights) {
-        fs.lights = shading_lights(*scene);
-    } else {
-        ShadingLight sun;
-        sun.direction = glm::normalize(glm::vec3(0.35f, 0.6f, 0.7f));
-        sun.radiance = glm::vec3(3.0f);
-        fs.lights = {sun};
-    }
-    fs.ambient = glm::vec3(0.05f);
-    fs.samples = samples;
+    FrameSettings fs = lw.settings;
     fs.shadows.enabled = shadows;
     fs.shadows.size = shadow_size;
     Framebuffer fb(width, height);
@@ -486,34 +500,10 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
 // the rounds' ratios (first count's frame / this count's frame).
 void measure_alternating(const Workload& w, const std::vector<int>& threads, int tile, int repeat, int width,
                          int height, int samples, bool json, std::vector<std::string>& out) {
-    DefaultScene builtin;
-    Scene loaded;
-    const Scene* scene;
-    Camera cam;
-    if (w.file.empty()) {
-        builtin = make_default_scene();
-        scene = &builtin.scene;
-        cam = builtin.camera;
-    } else {
-        loaded = load_scene(w.file);
-        scene = &loaded;
-        cam.eye = w.eye;
-        cam.target = w.target;
-        cam.fov_y_deg = w.fov;
-    }
-    fit_clip_planes(cam, scene->bounds());
-    FrameSettings fs;
-    fs.camera = cam;
-    if (w.own_lights) {
-        fs.lights = shading_lights(*scene);
-    } else {
-        ShadingLight sun;
-        sun.direction = glm::normalize(glm::vec3(0.35f, 0.6f, 0.7f));
-        sun.radiance = glm::vec3(3.0f);
-        fs.lights = {sun};
-    }
-    fs.ambient = glm::vec3(0.05f);
-    fs.samples = samples;
+    LoadedWorkload lw;
+    load_workload(w, samples, lw);
+    const Scene* scene = lw.scene;
+    FrameSettings fs = lw.settings;
     const std::size_t n = threads.size();
     std::vector<std::unique_ptr<Renderer>> renderers;
     std::vector<std::unique_ptr<SceneRenderer>> srs;
