@@ -63,7 +63,7 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     plan_environment(plan, env_w, env_h, opt.env);
     plan_shadows(plan, s.lights, opt.shadows);
     plan_recording(plan, out.scene, opt.width, opt.height, opt.samples);
-    const std::uint64_t budget = opt.memory_budget ? opt.memory_budget : memory_budget();
+    const std::uint64_t budget = memory_budget();
     if (plan.total() > budget) {
         err = {1, (opt.scene.empty() ? std::string("the built-in scene") : opt.scene) + ": recording the frame needs " +
                       plan.describe() + ", more than the " + std::to_string(budget) +

@@ -43,7 +43,6 @@ struct FrameRequest {
     int samples = 1;                         // per pixel (render's --msaa)
     ShadowSettings shadows;                  // render's --shadows, --shadow-size
     std::uint64_t bytes_per_pixel = 24;      // render's framebuffer and image per pixel
-    std::uint64_t memory_budget = 0;         // 0: half the physical memory
 };
 
 // A scene ready to draw: loaded, framed, lit, its textures bound.
