@@ -31,9 +31,16 @@ void add_quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, int 
 }
 
 // The plane y = 0, |x|, |z| <= h, facing up.
-void add_floor(Scene& s, float h) {
-    add_quad(s, {-h, 0, h}, {h, 0, h}, {h, 0, -h}, {-h, 0, -h});
+// The horizontal square of half-side h at height y, counter-clockwise seen
+// from above: the floor, the occluders and the shadows they cast.
+std::vector<glm::vec3> square(float h, float y) { return {{-h, y, h}, {h, y, h}, {h, y, -h}, {-h, y, -h}}; }
+
+void add_square(Scene& s, float h, float y) {
+    const std::vector<glm::vec3> c = square(h, y);
+    add_quad(s, c[0], c[1], c[2], c[3]);
 }
+
+void add_floor(Scene& s, float h) { add_square(s, h, 0.0f); }
 
 // An axis-aligned box [lo, hi], faces outwards.
 void add_box(Scene& s, glm::vec3 lo, glm::vec3 hi) {
@@ -180,7 +187,7 @@ TEST_SUITE("shadows") {
 TEST_CASE("a square occluder lit straight down casts its projection, outline within 2 pixels") {
     Scene s = base_scene();
     add_floor(s, 2.0f);
-    add_quad(s, {-0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, -0.5f}, {-0.5f, 0.5f, -0.5f});
+    add_square(s, 0.5f, 0.5f);
     Camera cam;
     cam.eye = {0.3f, 2.5f, 3.0f};
     cam.target = {0.0f, 0.0f, 0.0f};
@@ -190,10 +197,9 @@ TEST_CASE("a square occluder lit straight down casts its projection, outline wit
     const std::vector<ShadingLight> lights = {sun({0, 1, 0})};
     const Frame on = render(s, cam, lights, true, W, H);
     const Frame off = render(s, cam, lights, false, W, H);
-    const auto floor_poly = project_all(cam, W, H, {{-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}});
-    const auto shadow = project_all(cam, W, H, {{-0.5f, 0, 0.5f}, {0.5f, 0, 0.5f}, {0.5f, 0, -0.5f}, {-0.5f, 0, -0.5f}});
-    const auto occluder =
-        project_all(cam, W, H, {{-0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, -0.5f}, {-0.5f, 0.5f, -0.5f}});
+    const auto floor_poly = project_all(cam, W, H, square(2.0f, 0.0f));
+    const auto shadow = project_all(cam, W, H, square(0.5f, 0.0f));
+    const auto occluder = project_all(cam, W, H, square(0.5f, 0.5f));
     const Outline o = check_outline(on, off, floor_poly, shadow, occluder, 2.0f);
     MESSAGE("inside " << o.inside << ", outside " << o.outside << ", outline band " << o.band);
     CHECK(o.inside > 500);  // the visible part of the shadow is large enough to mean something
@@ -214,7 +220,7 @@ TEST_CASE("a lit plane with no occluder has no acne: every pixel as without shad
     cam.near_plane = 0.5f;
     cam.far_plane = 10.0f;
     const int W = 200, H = 150;
-    const auto floor_poly = project_all(cam, W, H, {{-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}});
+    const auto floor_poly = project_all(cam, W, H, square(2.0f, 0.0f));
     for (float deg : {0.0f, 30.0f, 60.0f, 75.0f}) {
         const float a = glm::radians(deg);
         const std::vector<ShadingLight> lights = {sun({std::sin(a) * 0.6f, std::cos(a), std::sin(a) * 0.8f})};
@@ -250,7 +256,7 @@ TEST_CASE("no light leaks where a box stands on the plane") {
     const std::vector<ShadingLight> lights = {sun({1, 1, 0})};
     const Frame on = render(s, cam, lights, true, W, H);
     const Frame off = render(s, cam, lights, false, W, H);
-    const auto floor_poly = project_all(cam, W, H, {{-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-2, 0, -2}});
+    const auto floor_poly = project_all(cam, W, H, square(2.0f, 0.0f));
     const auto box = hull(project_all(cam, W, H, box_corners(lo, hi)));
     // The shadow runs on under the box (hidden there): its edge at the foot
     // x = -0.25 is no outline, the pixels right next to the foot must be
@@ -283,7 +289,7 @@ TEST_CASE("a point light's cube map: the occluder's shadow is its central projec
     add_floor(s, 3.0f);
     // Light at height 2, occluder square of side 0.5 at height 1: the shadow
     // is the square of side 1 on the floor.
-    add_quad(s, {-0.25f, 1.0f, 0.25f}, {0.25f, 1.0f, 0.25f}, {0.25f, 1.0f, -0.25f}, {-0.25f, 1.0f, -0.25f});
+    add_square(s, 0.25f, 1.0f);
     ShadingLight lamp;
     lamp.point = true;
     lamp.position = {0.0f, 2.0f, 0.0f};
@@ -297,10 +303,9 @@ TEST_CASE("a point light's cube map: the occluder's shadow is its central projec
     const int W = 256, H = 192;
     const Frame on = render(s, cam, {lamp}, true, W, H);
     const Frame off = render(s, cam, {lamp}, false, W, H);
-    const auto floor_poly = project_all(cam, W, H, {{-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}});
-    const auto shadow = project_all(cam, W, H, {{-0.5f, 0, 0.5f}, {0.5f, 0, 0.5f}, {0.5f, 0, -0.5f}, {-0.5f, 0, -0.5f}});
-    const auto occluder =
-        project_all(cam, W, H, {{-0.25f, 1, 0.25f}, {0.25f, 1, 0.25f}, {0.25f, 1, -0.25f}, {-0.25f, 1, -0.25f}});
+    const auto floor_poly = project_all(cam, W, H, square(3.0f, 0.0f));
+    const auto shadow = project_all(cam, W, H, square(0.5f, 0.0f));
+    const auto occluder = project_all(cam, W, H, square(0.25f, 1.0f));
     // The floor beyond 2 m from the light's foot is seen by the side faces:
     // lit exactly as without shadows there too (checked with the rest).
     const Outline o = check_outline(on, off, floor_poly, shadow, occluder, 2.0f);
