@@ -72,6 +72,7 @@ struct Random {
     }
     double uniform() { return double(next() >> 11) * (1.0 / 9007199254740992.0); }
     double range(double a, double b) { return a + (b - a) * uniform(); }
+    int below(int n) { return int(next() % std::uint64_t(n)); }
 };
 
 // Clip-space position of window point (x, y) of a W x H target (y down), at

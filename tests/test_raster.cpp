@@ -32,22 +32,6 @@ namespace {
 // ---------------------------------------------------------------------------
 // Small tools
 
-// Deterministic generator (splitmix64): the same numbers on every platform,
-// unlike the standard distributions.
-struct Rng {
-    std::uint64_t s;
-    explicit Rng(std::uint64_t seed) : s(seed) {}
-    std::uint64_t next() {
-        std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform() { return double(next() >> 11) * (1.0 / 9007199254740992.0); }  // [0, 1)
-    double range(double a, double b) { return a + (b - a) * uniform(); }
-    int below(int n) { return int(next() % std::uint64_t(n)); }
-};
-
 constexpr double kPi = 3.14159265358979323846;
 
 DrawState count_state(CullMode cull = CullMode::None) {
@@ -248,7 +232,7 @@ std::vector<glm::vec4> project(const Camera& cam, const std::vector<glm::dvec3>&
 // multiples of 1/lattice pixel (so many edges pass exactly through centres).
 void jittered_grid(int W, int H, int cells_x, int cells_y, double lattice, std::uint64_t seed,
                    std::vector<glm::vec4>& clip, std::vector<std::uint32_t>& idx) {
-    Rng rng(seed);
+    Random rng(seed);
     const double x0 = -9.0, y0 = -9.0;
     const double sx = (W + 18.0) / cells_x, sy = (H + 18.0) / cells_y;
     clip.clear();
@@ -293,7 +277,7 @@ void jittered_grid(int W, int H, int cells_x, int cells_y, double lattice, std::
 // A fan of n triangles around (cx, cy) with outer vertices on a circle.
 void fan(int W, int H, double cx, double cy, double radius, int n, std::uint64_t seed,
          std::vector<glm::vec4>& clip, std::vector<std::uint32_t>& idx) {
-    Rng rng(seed);
+    Random rng(seed);
     clip.clear();
     idx.clear();
     clip.push_back(win(cx, cy, W, H));
@@ -779,7 +763,7 @@ TEST_CASE("fill rule: eight triangles around a vertex on a pixel centre cover it
     // The same vertex with an irregular ring far outside: every pixel once.
     {
         WinTris t{W, H, {}, {}};
-        Rng rng(5);
+        Random rng(5);
         std::vector<glm::dvec2> far_ring;
         for (int k = 0; k < 8; ++k) {
             double a = 2.0 * kPi * (k + rng.range(-0.3, 0.3)) / 8.0;
@@ -794,7 +778,7 @@ TEST_CASE("fill rule: eight triangles around a vertex on a pixel centre cover it
 TEST_CASE("fill rule: random triangles on the half-pixel lattice match the top-left rule exactly") {
     const int W = 32, H = 32;
     Renderer r(RendererOptions{1, 16});
-    Rng rng(2024);
+    Random rng(2024);
     int drawn = 0, on_edge_pixels = 0, mismatches = 0;
     for (int i = 0; i < 400; ++i) {
         glm::dvec2 v[3];
@@ -1458,7 +1442,7 @@ struct RandomScene {
 };
 
 RandomScene random_scene(int W, int H, int tris, std::uint64_t seed) {
-    Rng rng(seed);
+    Random rng(seed);
     RandomScene sc;
     for (int t = 0; t < tris; ++t) {
         int kind = rng.below(100);
