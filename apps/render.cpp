@@ -400,26 +400,17 @@ int run(int argc, char** argv) {
     if (CameraFault f = request_camera(camera_request, bounds, aspect, !opt.scene.empty(), camera, camera))
         return fail(f.kind == CameraFault::Flag ? kExitUsage : kExitBadFile, f.message);
 
-    // The environment: --env (its size read from the header), or the scene's
-    // own (the built-in sky).
-    int env_w = scene.environment ? scene.environment->width : 0;
-    int env_h = scene.environment ? scene.environment->height : 0;
-    if (!opt.env.empty()) {
-        ImageSource env_source;
-        env_source.path = env_source.name = opt.env;
-        if (!image_dimensions(env_source, env_w, env_h)) env_w = env_h = 0;  // decoding will say why
-    }
+    // Lights: the scene's and the flags'; the default rig only when neither has
+    // any and no environment (--env, or the scene's own sky) lights the scene.
+    FrameSettings settings;
+    bool used_default_rig = false;
+    settings.lights = frame_lights(scene, opt.lights, opt.no_default_lights, scene.environment || !opt.env.empty(),
+                                   used_default_rig);
 
     // The whole render must fit in memory before anything big is allocated.
     g_stage = "planning memory";
     MemoryPlan plan = plan_memory(scene, opt.width, opt.height, kBytesPerPixel);
-    plan_environment(plan, env_w, env_h, opt.env);
-    // Lights: the scene's and the flags'; the default rig only when neither has
-    // any and no environment lights the scene.
-    const bool has_environment = scene.environment || !opt.env.empty();
-    FrameSettings settings;
-    bool used_default_rig = false;
-    settings.lights = frame_lights(scene, opt.lights, opt.no_default_lights, has_environment, used_default_rig);
+    plan_environment(plan, scene, opt.env);
     plan_shadows(plan, settings.lights, opt.shadows);
     const std::uint64_t budget = memory_budget();
     if (plan.total() > budget)
@@ -427,6 +418,7 @@ int run(int argc, char** argv) {
                                       ": the render needs " + plan.describe() + ", more than the " +
                                       std::to_string(budget) + " bytes allowed (half the physical memory)");
 
+    // The environment: --env, or the scene's own (the built-in sky).
     std::shared_ptr<const Image> env_image = scene.environment;
     if (!opt.env.empty()) {
         try {

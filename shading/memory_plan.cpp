@@ -85,9 +85,16 @@ MemoryPlan plan_memory(const Scene& scene, int width, int height, std::uint64_t 
     return plan;
 }
 
-void plan_environment(MemoryPlan& plan, int width, int height, const std::string& name) {
+void plan_environment(MemoryPlan& plan, const Scene& scene, const std::string& env_path) {
+    int width = scene.environment ? scene.environment->width : 0;
+    int height = scene.environment ? scene.environment->height : 0;
+    if (!env_path.empty()) {
+        ImageSource src;
+        src.path = src.name = env_path;
+        if (!image_dimensions(src, width, height)) return;
+    }
     if (width <= 0 || height <= 0 || std::int64_t(width) * std::int64_t(height) > kMaxImageTexels) return;
-    plan.environment_name = name;
+    plan.environment_name = env_path;
     // The decoded file (float RGBA); the source resampled to at most kMaxWidth
     // with its mip chain, and its sampling tables (a float per texel); the
     // prefiltered levels are at most a third of level 0 again.

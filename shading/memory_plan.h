@@ -39,11 +39,12 @@ std::uint64_t memory_budget();
 // image of `bytes_per_pixel`.
 MemoryPlan plan_memory(const Scene& scene, int width, int height, std::uint64_t bytes_per_pixel);
 
-// An equirect environment of width x height texels (from the file `name`'s
-// header, or the scene's own map), decoded and prefiltered
-// (shading/environment.h). A map beyond kMaxImageTexels is left to the
-// decoder, which refuses it with its own message.
-void plan_environment(MemoryPlan& plan, int width, int height, const std::string& name = "");
+// The environment a render prefilters, decoded and with its levels
+// (shading/environment.h): the --env file `env_path` (its size read from the
+// header), else the scene's own map, else none. A map whose header cannot be
+// read, or beyond kMaxImageTexels, is left to the decoder, which refuses it
+// with its own message.
+void plan_environment(MemoryPlan& plan, const Scene& scene, const std::string& env_path);
 
 // One shadow map per light when shadows are on (shading/shadow_pass.h).
 void plan_shadows(MemoryPlan& plan, const std::vector<ShadingLight>& lights, const ShadowSettings& settings);

@@ -40,15 +40,8 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
         return false;
     }
 
-    // The environment's size (--env's header, or the scene's own map) and
-    // the lights, for the memory plan.
-    int env_w = out.scene.environment ? out.scene.environment->width : 0;
-    int env_h = out.scene.environment ? out.scene.environment->height : 0;
-    if (!opt.env.empty()) {
-        ImageSource env_source;
-        env_source.path = env_source.name = opt.env;
-        if (!image_dimensions(env_source, env_w, env_h)) env_w = env_h = 0;  // decoding will say why
-    }
+    // Lights (the memory plan counts their shadow maps); the default rig
+    // only when no light and no environment lights the scene.
     FrameSettings& s = out.settings;
     bool used_default_rig = false;
     s.lights = frame_lights(out.scene, opt.lights, opt.no_default_lights,
@@ -60,7 +53,7 @@ bool setup_scene(const FrameRequest& opt, StepScene& out, SetupError& err) {
     // render's memory plan, plus the recording: refused before anything big
     // is allocated.
     MemoryPlan plan = plan_memory(out.scene, opt.width, opt.height, opt.bytes_per_pixel);
-    plan_environment(plan, env_w, env_h, opt.env);
+    plan_environment(plan, out.scene, opt.env);
     plan_shadows(plan, s.lights, opt.shadows);
     plan_recording(plan, out.scene, opt.width, opt.height, opt.samples);
     const std::uint64_t budget = memory_budget();
