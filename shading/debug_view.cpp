@@ -23,6 +23,10 @@ bool parse_debug_view(const std::string& name, DebugView& out) {
     return false;
 }
 
+bool debug_view_is_lit(DebugView v) {
+    return v == DebugView::None || v == DebugView::Tiles || v == DebugView::Diffuse || v == DebugView::Specular;
+}
+
 bool debug_view_is_data(DebugView v) {
     switch (v) {
     case DebugView::Normal: case DebugView::Roughness: case DebugView::Metallic: case DebugView::Uv:

@@ -18,6 +18,9 @@ bool parse_debug_view(const std::string& name, DebugView& out);
 // D, F, G): written to 8 bits as they are, without tone map or sRGB encoding,
 // so that a byte reads back as the value (byte / 255).
 bool debug_view_is_data(DebugView v);
+// Views that run the lighting as the image does (none, tiles, diffuse,
+// specular): shadow maps are drawn and BLEND meshes blended only for these.
+bool debug_view_is_lit(DebugView v);
 const char* debug_view_names();  // "albedo, normal, ..." for messages
 
 } // namespace prast

@@ -173,8 +173,7 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
 
 std::vector<ShadingLight> SceneRenderer::shadowed_lights(const FrameSettings& s, float aspect) {
     std::vector<ShadingLight> lights = s.lights;
-    const bool lit = s.view == DebugView::None || s.view == DebugView::Tiles || s.view == DebugView::Diffuse ||
-                     s.view == DebugView::Specular;
+    const bool lit = debug_view_is_lit(s.view);
     if (!s.shadows.enabled || !lit || !(aspect > 0.0f)) {
         for (ShadingLight& L : lights) L.shadow = nullptr;
         return lights;
@@ -253,8 +252,7 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
     static const BoundMaterial kFallbackBound{&kFallback};
     // Opaque and MASK meshes in file order, then BLEND ones back to front,
     // blended over what is drawn (lit views; data views draw them opaque).
-    const bool lit = s.view == DebugView::None || s.view == DebugView::Tiles || s.view == DebugView::Diffuse ||
-                     s.view == DebugView::Specular;
+    const bool lit = debug_view_is_lit(s.view);
     for (const std::size_t mi : draw_order(scene_, s.camera.eye)) {
         const Mesh& mesh = scene_.meshes[mi];
         if (mesh.indices.empty()) continue;
