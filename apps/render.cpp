@@ -497,6 +497,7 @@ int run(int argc, char** argv) {
     out8.exposure = opt.exposure;
     out8.tonemap = opt.effective_tonemap();
     out8.raw = debug_view_is_data(opt.view);
+    out8.keep_framebuffer = opt.pixel.has_value();  // --pixel reads the linear colour and depth
     std::vector<double> frame_ms;
     int step = 2;
     for (int frame = opt.first_frame; frame <= opt.last_frame; ++frame) {

@@ -36,6 +36,12 @@ struct FrameOptions {
     bool clear = true;      // clear colour and depth in the tile pass; false: draw over the target
     float clear_color[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     float clear_depth = 1.0f;
+    // Only the tile hook's view of each tile is wanted, not the framebuffer
+    // (render writing a PNG): with clear, every tile then lives in its
+    // worker's tile-local storage, which stays in cache, and the framebuffer
+    // is neither written nor read (it keeps what it held). The hook sees the
+    // same colours either way.
+    bool transient = false;
     // Optional: a colour per pixel to clear to instead of clear_color (a
     // background image): clear_fill(clear_user, x0, y0, width, height, rgba,
     // row) writes pixel (x0 + i, y0 + j)'s RGBA at rgba[j * row + 4 i]; every
@@ -166,7 +172,7 @@ private:
 };
 
 // One worker's tile-local storage, reused tile after tile: the samples of a
-// multisampled tile, the winner of each sample (kNoWinner between tiles), a
+// multisampled or transient tile, the winner of each sample (kNoWinner between tiles), a
 // dirty bit per 4x4 block holding winners, and the tile's winning triangles.
 struct TileScratch {
     struct Ref {
@@ -175,6 +181,8 @@ struct TileScratch {
         const TriangleSetup* tri;
     };
     std::vector<float> color, depth;
+    std::vector<float> resolved;  // transient frames, several samples: the averages
+    std::vector<float> uniform;   // transient frames: a tile of the clear colour
     std::vector<std::uint32_t> winner;
     std::vector<std::uint64_t> dirty;
     std::vector<Ref> refs;

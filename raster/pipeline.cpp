@@ -165,12 +165,27 @@ void Renderer::finish(TileHook hook, void* user) {
     const std::size_t plane = std::size_t(tile_size_) * std::size_t(tile_size_);
     const int blocks = (tile_size_ / kBlockSize) * (tile_size_ / kBlockSize);
     if (scratch_.size() != std::size_t(workers)) scratch_.resize(std::size_t(workers));
+    const bool transient = options_.transient && options_.clear;
+    // A transient tile no draw reaches shows S cleared samples resolved: the
+    // clear colour, or infinities where the sums overflow (resolve.cpp).
+    float uniform_color[4];
+    std::memcpy(uniform_color, options_.clear_color, sizeof uniform_color);
+    if (S > 1) {
+        float samples[kMaxSamples * 4];
+        for (int s = 0; s < S; ++s) std::memcpy(samples + 4 * s, options_.clear_color, 4 * sizeof(float));
+        resolve_samples_local(samples, 1, S, 1, 1, uniform_color);
+    }
     for (detail::TileScratch& sc : scratch_) {
         if (sc.winner.size() != plane * std::size_t(S)) sc.winner.assign(plane * std::size_t(S), kNoWinner);
         sc.dirty.assign(std::size_t((blocks + 63) / 64), 0);
-        if (S > 1) {
+        if (S > 1 || transient) {
             sc.depth.resize(plane * std::size_t(S));
             sc.color.resize(fb_->has_color() ? plane * std::size_t(S) * 4 : 0);
+        }
+        if (transient && fb_->has_color()) {
+            if (S > 1) sc.resolved.resize(plane * 4);
+            sc.uniform.resize(plane * 4);
+            for (std::size_t i = 0; i < plane * 4; i += 4) std::memcpy(&sc.uniform[i], uniform_color, sizeof uniform_color);
         }
     }
     worker_stats_.assign(std::size_t(workers), FrameStats{});
@@ -207,7 +222,8 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     c.dirty = sc.dirty.data();
     c.blocks_x = T / kBlockSize;
     TileTarget& tg = c.target;
-    if (S == 1) {
+    const bool transient = options_.transient && options_.clear;
+    if (S == 1 && !transient) {
         tg.color = fb.has_color() ? fb.color.data() : nullptr;
         tg.depth = fb.depth.data();
         tg.row = std::size_t(fb.width);
@@ -241,8 +257,8 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     // Several samples all cleared to one value resolve to exactly that value
     // (resolve.cpp: pairwise sums of equal values, times 1/S), unless the
     // sums overflow: such a tile is cleared in the framebuffer directly.
-    bool direct = S == 1;
-    if (uniform && S > 1) {
+    bool direct = S == 1 && !transient;
+    if (uniform && S > 1 && !transient) {
         direct = true;
         for (int k = 0; k < 4; ++k) direct &= std::fabs(options_.clear_color[k]) <= 0x1p100f;
     }
@@ -251,11 +267,12 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     if (options_.clear) {
         // Streamed at one sample, where it measured faster on 2 threads (bench
         // --alternate, bottle); with several samples the difference was in the noise.
-        if (uniform && direct && S == 1) clear_tile_streaming(fb, r, options_.clear_color, options_.clear_depth);
+        if (uniform && transient) {}  // the hook sees sc.uniform
+        else if (uniform && direct && S == 1) clear_tile_streaming(fb, r, options_.clear_color, options_.clear_depth);
         else if (direct) clear_tile(fb, r, options_.clear_color, options_.clear_depth);
         else clear_samples(tg.color, tg.depth, T, S, options_.clear_color, options_.clear_depth);
         if (options_.clear_fill && tg.color) {
-            if (S == 1) {
+            if (!tg.local) {
                 options_.clear_fill(options_.clear_user, r.x0, r.y0, r.width(), r.height(),
                                     &fb.color[(std::size_t(r.y0) * std::size_t(fb.width) + std::size_t(r.x0)) * 4],
                                     std::size_t(fb.width) * 4);
@@ -345,15 +362,27 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     stats.tiles_touched += touched;
 
     // End: resolve the samples, then hand the tile's colour to the hook.
-    if (!direct) resolve_samples(tg.color, tg.depth, T, S, r, fb);
+    if (!direct && !transient) resolve_samples(tg.color, tg.depth, T, S, r, fb);
     if (hook && fb.has_color()) {
         TileView v;
         v.x0 = r.x0;
         v.y0 = r.y0;
         v.width = r.width();
         v.height = r.height();
-        v.rgba = &fb.color[(std::size_t(r.y0) * std::size_t(fb.width) + std::size_t(r.x0)) * 4];
-        v.row = std::size_t(fb.width) * 4;
+        if (!transient) {
+            v.rgba = &fb.color[(std::size_t(r.y0) * std::size_t(fb.width) + std::size_t(r.x0)) * 4];
+            v.row = std::size_t(fb.width) * 4;
+        } else {
+            if (uniform) {
+                v.rgba = sc.uniform.data();
+            } else if (S == 1) {
+                v.rgba = tg.color;
+            } else {
+                resolve_samples_local(tg.color, T, S, r.width(), r.height(), sc.resolved.data());
+                v.rgba = sc.resolved.data();
+            }
+            v.row = std::size_t(T) * 4;
+        }
         v.uniform = uniform;
         hook(user, v);
     }

@@ -65,6 +65,7 @@ inline void resolve_row(const float* color, const float* depth, std::size_t plan
                         float* out_depth) {
     constexpr float kInv = 1.0f / float(S);
     int x = 0;
+    if (!out_depth) x = width;  // colour only
     for (; x + 8 <= width; x += 8) {
         Floats8 z;
         std::memcpy(&z, depth + x, sizeof z);
@@ -117,6 +118,19 @@ void resolve_samples(const float* color, const float* depth, int size, int sampl
         case 4: resolve_row<4>(c, depth + src, plane, r.width(), oc, od); break;
         case 8: resolve_row<8>(c, depth + src, plane, r.width(), oc, od); break;
         default: resolve_row<1>(c, depth + src, plane, r.width(), oc, od); break;
+        }
+    }
+}
+
+void resolve_samples_local(const float* color, int size, int samples, int width, int height, float* out) {
+    const std::size_t plane = std::size_t(size) * std::size_t(size);
+    for (int y = 0; y < height; ++y) {
+        const std::size_t at = std::size_t(y) * std::size_t(size) * 4;
+        switch (samples) {
+        case 2: resolve_row<2>(color + at, nullptr, plane, width, out + at, nullptr); break;
+        case 4: resolve_row<4>(color + at, nullptr, plane, width, out + at, nullptr); break;
+        case 8: resolve_row<8>(color + at, nullptr, plane, width, out + at, nullptr); break;
+        default: resolve_row<1>(color + at, nullptr, plane, width, out + at, nullptr); break;
         }
     }
 }

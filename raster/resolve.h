@@ -33,5 +33,9 @@ void load_samples(const Framebuffer& fb, const TileRect& r, float* color, float*
 // nearest sample depth.
 void resolve_samples(const float* color, const float* depth, int size, int samples, const TileRect& r,
                      Framebuffer& fb);
+// The same averages of the colour samples into tile-local storage (`size`
+// pixels a row, the first width x height pixels), for a transient frame
+// (FrameOptions::transient); no depth.
+void resolve_samples_local(const float* color, int size, int samples, int width, int height, float* out);
 
 } // namespace prast

@@ -243,6 +243,8 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
     FrameOptions frame;
     frame.samples = s.samples;
     frame.visibility = s.visibility;
+    const bool overlay = s.view == DebugView::Overdraw || s.view == DebugView::Tiles;
+    frame.transient = out && !out->keep_framebuffer && !overlay;
     const BackgroundFill background = frame_background(s, ctx.env, fb.width, fb.height);
     background.attach(frame);
     renderer_.begin(fb, frame);
@@ -282,7 +284,6 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
     }
     // The 8-bit image: from each finished tile, unless a whole-image overlay
     // comes first (then after it, rows in parallel).
-    const bool overlay = s.view == DebugView::Overdraw || s.view == DebugView::Tiles;
     TileResolve resolve;
     if (out) {
         resolve.rgba8 = out->rgba8;

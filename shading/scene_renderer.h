@@ -52,6 +52,10 @@ struct ImageOutput {
     float exposure = 1.0f;
     ToneMap tonemap = ToneMap::Aces;
     bool raw = false;               // resolve_raw8 instead (data debug views)
+    // Also leave the linear colour and depth in the framebuffer. false: only
+    // the 8-bit image is wanted (render without --pixel), and the frame keeps
+    // its tiles in cache (FrameOptions::transient); the same 8-bit bytes.
+    bool keep_framebuffer = true;
 };
 
 // Scene lights (KHR_lights_punctual) in shading form.
@@ -76,7 +80,8 @@ public:
     // Renders one frame into fb (resized by the caller): clears to the
     // background (frame_background), draws every mesh, and applies the
     // overdraw/tiles debug overlays. With `out`, also writes the 8-bit image
-    // (in the tile pass, on every thread).
+    // (in the tile pass, on every thread); out->keep_framebuffer false leaves
+    // fb as it was.
     void render(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out = nullptr);
 
     // The environment a frame with these settings is lit by (null: none).

@@ -492,6 +492,72 @@ TEST_CASE("stream_fill: the bytes of a plain fill at any alignment and length, a
     CHECK(wrong == 0);
 }
 
+TEST_CASE("frame: a transient frame hands the hook the same colours and leaves the framebuffer alone") {
+    // FrameOptions::transient keeps each tile in tile-local storage. Against
+    // the same frame kept in the framebuffer: every sample count, two tile
+    // sizes, a background fill, a clear whose sums overflow (uniform tiles
+    // resolve to infinity at several samples), and tiles no draw reaches.
+    const OverdrawScene sc(150, 97, 5, true);
+    const std::vector<std::uint32_t> corner = {0, 1, 2};
+    auto fill = [](const void*, int x0, int y0, int w, int h, float* rgba, std::size_t row) {
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (int c = 0; c < 4; ++c) rgba[std::size_t(y) * row + 4 * std::size_t(x) + std::size_t(c)] = float(((x0 + x) * 3 + (y0 + y) * 5 + c) % 17) / 16.0f;
+    };
+    for (int variant = 0; variant < 3; ++variant)
+        for (int samples : {1, 2, 4, 8})
+            for (int tile : {16, 64}) {
+                CAPTURE(variant);
+                CAPTURE(samples);
+                CAPTURE(tile);
+                std::vector<float> views[2];
+                Framebuffer fbs[2] = {Framebuffer(sc.W, sc.H), Framebuffer(sc.W, sc.H)};
+                fbs[1].clear(-1.0f, -2.0f, -3.0f, -4.0f, 0.5f);
+                const Framebuffer before = fbs[1];
+                int uniform_tiles = 0;
+                for (int transient = 0; transient < 2; ++transient) {
+                    Renderer r({3, tile});
+                    FrameOptions o = frame_options(FrameOptions::Visibility::Auto, samples);
+                    o.transient = transient == 1;
+                    if (variant == 1) o.clear_fill = fill;
+                    if (variant == 2) o.clear_color[1] = 3e38f;
+                    std::vector<float>& seen = views[transient];
+                    seen.assign(std::size_t(sc.W) * sc.H * 4, -7.0f);
+                    std::vector<int> count(std::size_t(sc.W) * sc.H, 0);
+                    std::mutex m;
+                    r.begin(fbs[transient], o);
+                    if (variant == 2) {  // one corner triangle: most tiles stay uniform
+                        PaintProgram p{sc.clip.data(), sc.var.data(), false, 1.0f};
+                        r.submit(p, std::uint32_t(sc.clip.size()), corner.data(), corner.size());
+                    } else {
+                        sc.submit(r);
+                    }
+                    r.end([&](const TileView& v) {
+                        std::lock_guard<std::mutex> lock(m);
+                        uniform_tiles += transient && v.uniform;
+                        for (int y = 0; y < v.height; ++y)
+                            for (int x = 0; x < v.width; ++x) {
+                                const std::size_t p = std::size_t(v.y0 + y) * sc.W + std::size_t(v.x0 + x);
+                                ++count[p];
+                                std::memcpy(&seen[p * 4], &v.rgba[std::size_t(y) * v.row + 4 * std::size_t(x)], 4 * sizeof(float));
+                            }
+                    });
+                    int not_once = 0;
+                    for (int n : count) not_once += n != 1;
+                    CHECK(not_once == 0);
+                }
+                CHECK(std::memcmp(views[0].data(), views[1].data(), views[0].size() * sizeof(float)) == 0);
+                CHECK(std::memcmp(views[0].data(), fbs[0].color.data(), views[0].size() * sizeof(float)) == 0);
+                CHECK(fbs[1].color == before.color);
+                CHECK(fbs[1].depth == before.depth);
+                if (variant == 2) {
+                    CHECK(uniform_tiles > (tile == 16 ? 40 : 2));
+                    CHECK(views[1].back() == 1.0f);  // alpha
+                    CHECK(std::isinf(views[1][views[1].size() - 3]) == (samples > 1));
+                }
+            }
+}
+
 TEST_CASE("frame: misuse is refused") {
     Renderer r({1, 16});
     Framebuffer fb(8, 8);

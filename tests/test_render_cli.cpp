@@ -542,6 +542,16 @@ TEST_CASE("--pixel reports the depth, the colour and the triangle") {
     CHECK(floor.code == 0);
     CHECK(floor.out.find("pixel 48,50 frame 0: depth 0.") != std::string::npos);
     CHECK(floor.out.find("material 'tiles'") != std::string::npos);
+    // --pixel keeps the linear framebuffer for its report; without it the
+    // frame's tiles stay tile-local (FrameOptions::transient): the same PNG.
+    for (const char* n : {"1", "4"}) {
+        CAPTURE(n);
+        REQUIRE(render(box, with(kSmall, {"--msaa", n, "--pixel", "48,50", "-o", "kept.png"})).code == 0);
+        REQUIRE(render(box, with(kSmall, {"--msaa", n, "-o", "transient.png"})).code == 0);
+        const std::vector<std::uint8_t> kept = read_bytes(box.path("kept.png"));
+        REQUIRE(!kept.empty());
+        CHECK(read_bytes(box.path("transient.png")) == kept);
+    }
 }
 
 // A small equirect .hdr: a gradient sky (blue up, warm below) with a bright
