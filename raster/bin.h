@@ -83,8 +83,8 @@ void sort_bins(BinJob& job, int tile_count);
 // up and bins them into `job`, counting each submitted triangle once.
 template <class Observer>
 void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, const std::uint32_t* indices,
-                   const float* vertices, std::uint32_t vertex_count, int stride, const TileGrid& grid,
-                   const SampleExtent& samples, bool cull_back, Observer& obs) {
+                   const float* vertices, const std::uint16_t* codes, std::uint32_t vertex_count, int stride,
+                   const TileGrid& grid, const SampleExtent& samples, bool cull_back, Observer& obs) {
     const GuardBand gb = GuardBand::for_viewport(grid.width, grid.height);
     float polygon[kMaxClippedVertices * (4 + kMaxVaryings)];
     FrameStats& st = job.stats;
@@ -123,21 +123,23 @@ void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, cons
         const std::uint32_t prim = std::uint32_t(tri);
         ++st.triangles_in;
         std::uint32_t ref[3] = {indices[3 * tri], indices[3 * tri + 1], indices[3 * tri + 2]};
-        // Assemble; drop triangles with bad indices or non-finite positions.
+        // Assemble; drop triangles with bad indices or non-finite positions
+        // (codes: vertex_outcodes() of the vertex pass).
         bool valid = ref[0] < vertex_count && ref[1] < vertex_count && ref[2] < vertex_count;
         const float* clip[3] = {nullptr, nullptr, nullptr};
+        std::uint32_t oc0 = 0, oc1 = 0, oc2 = 0;
         if (valid) {
-            for (int i = 0; i < 3; ++i) {
-                clip[i] = &vertices[std::size_t(ref[i]) * stride];
-                for (int c = 0; c < 4; ++c) valid &= std::isfinite(clip[i][c]);
-            }
+            for (int i = 0; i < 3; ++i) clip[i] = &vertices[std::size_t(ref[i]) * stride];
+            oc0 = codes[ref[0]];
+            oc1 = codes[ref[1]];
+            oc2 = codes[ref[2]];
+            valid = !((oc0 | oc1 | oc2) & kVertexNotFinite);
         }
         if (!valid) {
             ++st.triangles_invalid;
             if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::Invalid, false, nullptr);
             continue;
         }
-        std::uint32_t oc0 = outcode(clip[0], gb), oc1 = outcode(clip[1], gb), oc2 = outcode(clip[2], gb);
         if (oc0 & oc1 & oc2 & kFrustumBits) {
             ++st.triangles_culled_frustum;
             if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::CulledFrustum, false, nullptr);

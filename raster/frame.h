@@ -115,6 +115,7 @@ public:
     const std::uint32_t* indices = nullptr;
     std::size_t tri_count = 0;
     std::vector<float>* vertices = nullptr;  // post-vertex-shader, stride floats each
+    std::vector<std::uint16_t>* outcodes = nullptr;  // vertex_outcodes() of each vertex
     int first_job = 0, job_count = 0;
 };
 
@@ -128,7 +129,7 @@ public:
     }
     void bin(BinJob& job, std::size_t tri_begin, std::size_t tri_end, const TileGrid& grid,
              const SampleExtent& samples) override {
-        bin_triangles(job, tri_begin, tri_end, indices, vertices->data(), vertex_count, stride, grid, samples,
+        bin_triangles(job, tri_begin, tri_end, indices, vertices->data(), outcodes->data(), vertex_count, stride, grid, samples,
                       state.cull == CullMode::Back, *obs_);
     }
     // Each entry dispatches once on the sample count: one sample is compiled

@@ -93,11 +93,15 @@ void Renderer::finish(TileHook hook, void* user) {
     // Vertex stage: chunks of vertices of every draw, one pass.
     auto t0 = Clock::now();
     if (vertex_buffers_.size() < draws_.size()) vertex_buffers_.resize(draws_.size());
+    if (outcode_buffers_.size() < draws_.size()) outcode_buffers_.resize(draws_.size());
+    const GuardBand guard_band = GuardBand::for_viewport(grid_.width, grid_.height);
     std::vector<int> vchunk_end(std::size_t(ndraws) + 1, 0);
     for (int d = 0; d < ndraws; ++d) {
         detail::DrawRecord& dr = *draws_[std::size_t(d)];
         dr.vertices = &vertex_buffers_[std::size_t(d)];
         dr.vertices->resize(std::size_t(dr.vertex_count) * std::size_t(dr.stride));
+        dr.outcodes = &outcode_buffers_[std::size_t(d)];
+        dr.outcodes->resize(dr.vertex_count);
         const int chunks = int((std::uint64_t(dr.vertex_count) + kVertexChunk - 1) / kVertexChunk);
         vchunk_end[std::size_t(d) + 1] = vchunk_end[std::size_t(d)] + chunks;
         stats_.vertices += dr.vertex_count;
@@ -108,6 +112,7 @@ void Renderer::finish(TileHook hook, void* user) {
         const std::uint32_t begin = std::uint32_t(task - vchunk_end[std::size_t(d)]) * kVertexChunk;
         const std::uint32_t end = std::min<std::uint32_t>(dr.vertex_count, begin + kVertexChunk);
         dr.shade_vertices(begin, end);
+        vertex_outcodes(dr.vertices->data(), dr.stride, begin, end, guard_band, dr.outcodes->data());
     });
     stats_.ms_vertex += ms_since(t0);
 

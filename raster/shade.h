@@ -153,36 +153,48 @@ inline void write_color(float* color, std::size_t row, std::uint32_t mask, const
         }
         return;
     }
-    if (mask == 0xFFFFu) {
-        // Every pixel: lanes 2j and 2j + 1 are neighbours in a row, written
-        // as one pair of RGBA pixels.
 #if defined(__AVX2__)
-        for (int h = 0; h < kBlockLanes; h += 8) {
-            const __m256 r = _mm256_load_ps(out.r + h), g = _mm256_load_ps(out.g + h);
-            const __m256 b = _mm256_load_ps(out.b + h), a = _mm256_load_ps(out.a + h);
-            // Interleave: RGBA of lane h + i in the half of p[i % 4] given by i / 4.
-            const __m256d rg_lo = _mm256_castps_pd(_mm256_unpacklo_ps(r, g));
-            const __m256d ba_lo = _mm256_castps_pd(_mm256_unpacklo_ps(b, a));
-            const __m256d rg_hi = _mm256_castps_pd(_mm256_unpackhi_ps(r, g));
-            const __m256d ba_hi = _mm256_castps_pd(_mm256_unpackhi_ps(b, a));
-            const __m256 p0 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_lo, ba_lo));
-            const __m256 p1 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_lo, ba_lo));
-            const __m256 p2 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_hi, ba_hi));
-            const __m256 p3 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_hi, ba_hi));
-            _mm256_storeu_ps(color + lane_offset_in(row, h) * 4, _mm256_permute2f128_ps(p0, p1, 0x20));
-            _mm256_storeu_ps(color + lane_offset_in(row, h + 2) * 4, _mm256_permute2f128_ps(p2, p3, 0x20));
-            _mm256_storeu_ps(color + lane_offset_in(row, h + 4) * 4, _mm256_permute2f128_ps(p0, p1, 0x31));
-            _mm256_storeu_ps(color + lane_offset_in(row, h + 6) * 4, _mm256_permute2f128_ps(p2, p3, 0x31));
+    // Lanes 2j and 2j + 1 are neighbours in a row: each pair of RGBA pixels is
+    // one 8-float store (masked to the pixels in `mask`).
+    for (int h = 0; h < kBlockLanes; h += 8) {
+        if (!((mask >> h) & 0xFFu)) continue;
+        const __m256 r = _mm256_load_ps(out.r + h), g = _mm256_load_ps(out.g + h);
+        const __m256 b = _mm256_load_ps(out.b + h), a = _mm256_load_ps(out.a + h);
+        // Interleave: RGBA of lane h + i in the half of p[i % 4] given by i / 4.
+        const __m256d rg_lo = _mm256_castps_pd(_mm256_unpacklo_ps(r, g));
+        const __m256d ba_lo = _mm256_castps_pd(_mm256_unpacklo_ps(b, a));
+        const __m256d rg_hi = _mm256_castps_pd(_mm256_unpackhi_ps(r, g));
+        const __m256d ba_hi = _mm256_castps_pd(_mm256_unpackhi_ps(b, a));
+        const __m256 p0 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_lo, ba_lo));
+        const __m256 p1 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_lo, ba_lo));
+        const __m256 p2 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg_hi, ba_hi));
+        const __m256 p3 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg_hi, ba_hi));
+        const __m256 pairs[4] = {_mm256_permute2f128_ps(p0, p1, 0x20), _mm256_permute2f128_ps(p2, p3, 0x20),
+                                 _mm256_permute2f128_ps(p0, p1, 0x31), _mm256_permute2f128_ps(p2, p3, 0x31)};
+        for (int j = 0; j < 4; ++j) {
+            const int l = h + 2 * j;
+            const std::uint32_t two = (mask >> l) & 3u;
+            float* c = color + lane_offset_in(row, l) * 4;
+            if (two == 3u) {
+                _mm256_storeu_ps(c, pairs[j]);
+            } else if (two) {
+                const __m256i left = _mm256_setr_epi32(-1, -1, -1, -1, 0, 0, 0, 0);
+                const __m256i right = _mm256_setr_epi32(0, 0, 0, 0, -1, -1, -1, -1);
+                _mm256_maskstore_ps(c, two == 1u ? left : right, pairs[j]);
+            }
         }
+    }
+    return;
 #else
+    if (mask == 0xFFFFu) {
         for (int l = 0; l < kBlockLanes; l += 2) {
             const float pair[8] = {out.r[l], out.g[l], out.b[l], out.a[l],
                                    out.r[l + 1], out.g[l + 1], out.b[l + 1], out.a[l + 1]};
             std::memcpy(color + lane_offset_in(row, l) * 4, pair, sizeof pair);
         }
-#endif
         return;
     }
+#endif
     for (std::uint32_t m = mask; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         float* c = color + lane_offset_in(row, l) * 4;
