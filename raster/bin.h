@@ -15,6 +15,7 @@
 #include "raster/samples.h"
 #include "raster/setup.h"
 #include "raster/stats.h"
+#include "raster/vertex.h"
 
 namespace prast {
 
@@ -83,18 +84,26 @@ void sort_bins(BinJob& job, int tile_count);
 // up and bins them into `job`, counting each submitted triangle once.
 template <class Observer>
 void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, const std::uint32_t* indices,
-                   const float* vertices, const std::uint16_t* codes, std::uint32_t vertex_count, int stride,
-                   const TileGrid& grid, const SampleExtent& samples, bool cull_back, Observer& obs) {
+                   const float* vertices, const std::uint16_t* codes, const WindowVertex* window,
+                   std::uint32_t vertex_count, int stride, const TileGrid& grid, const SampleExtent& samples,
+                   bool cull_back, Observer& obs) {
     const GuardBand gb = GuardBand::for_viewport(grid.width, grid.height);
     float polygon[kMaxClippedVertices * (4 + kMaxVaryings)];
     FrameStats& st = job.stats;
 
     // Sets up one (piece of a) triangle and bins it. Counting is left to the
     // caller, so that a clipped triangle counts once however many pieces it has.
+    // Unclipped triangles use the vertex pass's projections (`window`).
     auto emit = [&](const float* const clip[3], const std::uint32_t ref[3], std::uint32_t prim,
-                    bool clipped) -> SetupResult {
+                    bool clipped) __attribute__((always_inline)) -> SetupResult {
         TriangleSetup t;
-        SetupResult r = setup_triangle(clip, ref, grid.width, grid.height, cull_back, t, samples);
+        SetupResult r;
+        if (clipped) {
+            r = setup_triangle(clip, ref, grid.width, grid.height, cull_back, t, samples);
+        } else {
+            const WindowVertex* const v[3] = {&window[ref[0]], &window[ref[1]], &window[ref[2]]};
+            r = setup_triangle(v, ref, grid.width, grid.height, cull_back, t, samples);
+        }
         if (r == SetupResult::CulledBack) {
             if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::CulledBack, clipped, nullptr);
             return r;
@@ -124,7 +133,7 @@ void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, cons
         ++st.triangles_in;
         std::uint32_t ref[3] = {indices[3 * tri], indices[3 * tri + 1], indices[3 * tri + 2]};
         // Assemble; drop triangles with bad indices or non-finite positions
-        // (codes: vertex_outcodes() of the vertex pass).
+        // (codes: project_vertices() of the vertex pass).
         bool valid = ref[0] < vertex_count && ref[1] < vertex_count && ref[2] < vertex_count;
         const float* clip[3] = {nullptr, nullptr, nullptr};
         std::uint32_t oc0 = 0, oc1 = 0, oc2 = 0;

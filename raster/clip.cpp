@@ -1,7 +1,6 @@
 // Sutherland-Hodgman clipping in homogeneous coordinates; see clip.h.
 #include "raster/clip.h"
 
-#include <cmath>
 #include <cstring>
 
 namespace prast {
@@ -31,16 +30,6 @@ std::uint32_t outcode(const float* c, const GuardBand& gb) {
     if (y < -gb.y * w) code |= kOutGuardBottom;
     if (y > gb.y * w) code |= kOutGuardTop;
     return code;
-}
-
-void vertex_outcodes(const float* vertices, int stride, std::uint32_t begin, std::uint32_t end,
-                     const GuardBand& gb, std::uint16_t* codes) {
-    for (std::uint32_t v = begin; v < end; ++v) {
-        const float* c = vertices + std::size_t(v) * std::size_t(stride);
-        bool finite = true;
-        for (int k = 0; k < 4; ++k) finite &= std::isfinite(c[k]);
-        codes[v] = std::uint16_t(finite ? outcode(c, gb) : kVertexNotFinite);
-    }
 }
 
 namespace {

@@ -28,15 +28,6 @@ struct GuardBand {
 
 std::uint32_t outcode(const float* clip, const GuardBand& gb);
 
-// A vertex with a non-finite coordinate: its triangles are dropped (invalid).
-constexpr std::uint32_t kVertexNotFinite = 1u << 15;
-
-// outcode() of vertices [begin, end) (`stride` floats each, xyzw first), or
-// kVertexNotFinite, into codes[begin, end): once per vertex in the vertex
-// pass, not once per triangle corner in binning.
-void vertex_outcodes(const float* vertices, int stride, std::uint32_t begin, std::uint32_t end,
-                     const GuardBand& gb, std::uint16_t* codes);
-
 // Clips triangle (v[0], v[1], v[2]) -- each `stride` floats: xyzw then varyings --
 // against the planes named in `planes` (kClipNeededBits). Writes the convex
 // result polygon into out (kMaxClippedVertices * stride floats) and returns its

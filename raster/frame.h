@@ -115,7 +115,8 @@ public:
     const std::uint32_t* indices = nullptr;
     std::size_t tri_count = 0;
     std::vector<float>* vertices = nullptr;  // post-vertex-shader, stride floats each
-    std::vector<std::uint16_t>* outcodes = nullptr;  // vertex_outcodes() of each vertex
+    std::vector<std::uint16_t>* outcodes = nullptr;  // project_vertices() of each vertex
+    std::vector<WindowVertex>* window = nullptr;
     int first_job = 0, job_count = 0;
 };
 
@@ -129,7 +130,8 @@ public:
     }
     void bin(BinJob& job, std::size_t tri_begin, std::size_t tri_end, const TileGrid& grid,
              const SampleExtent& samples) override {
-        bin_triangles(job, tri_begin, tri_end, indices, vertices->data(), outcodes->data(), vertex_count, stride, grid, samples,
+        bin_triangles(job, tri_begin, tri_end, indices, vertices->data(), outcodes->data(), window->data(),
+                      vertex_count, stride, grid, samples,
                       state.cull == CullMode::Back, *obs_);
     }
     // Each entry dispatches once on the sample count: one sample is compiled

@@ -94,6 +94,7 @@ void Renderer::finish(TileHook hook, void* user) {
     auto t0 = Clock::now();
     if (vertex_buffers_.size() < draws_.size()) vertex_buffers_.resize(draws_.size());
     if (outcode_buffers_.size() < draws_.size()) outcode_buffers_.resize(draws_.size());
+    if (window_buffers_.size() < draws_.size()) window_buffers_.resize(draws_.size());
     const GuardBand guard_band = GuardBand::for_viewport(grid_.width, grid_.height);
     std::vector<int> vchunk_end(std::size_t(ndraws) + 1, 0);
     for (int d = 0; d < ndraws; ++d) {
@@ -102,6 +103,8 @@ void Renderer::finish(TileHook hook, void* user) {
         dr.vertices->resize(std::size_t(dr.vertex_count) * std::size_t(dr.stride));
         dr.outcodes = &outcode_buffers_[std::size_t(d)];
         dr.outcodes->resize(dr.vertex_count);
+        dr.window = &window_buffers_[std::size_t(d)];
+        dr.window->resize(dr.vertex_count);
         const int chunks = int((std::uint64_t(dr.vertex_count) + kVertexChunk - 1) / kVertexChunk);
         vchunk_end[std::size_t(d) + 1] = vchunk_end[std::size_t(d)] + chunks;
         stats_.vertices += dr.vertex_count;
@@ -112,7 +115,8 @@ void Renderer::finish(TileHook hook, void* user) {
         const std::uint32_t begin = std::uint32_t(task - vchunk_end[std::size_t(d)]) * kVertexChunk;
         const std::uint32_t end = std::min<std::uint32_t>(dr.vertex_count, begin + kVertexChunk);
         dr.shade_vertices(begin, end);
-        vertex_outcodes(dr.vertices->data(), dr.stride, begin, end, guard_band, dr.outcodes->data());
+        project_vertices(dr.vertices->data(), dr.stride, begin, end, guard_band, grid_.width, grid_.height,
+                         dr.outcodes->data(), dr.window->data());
     });
     stats_.ms_vertex += ms_since(t0);
 

@@ -133,6 +133,7 @@ private:
     // Storage reused from frame to frame.
     std::vector<std::vector<float>> vertex_buffers_;   // by draw slot
     std::vector<std::vector<std::uint16_t>> outcode_buffers_;  // by draw slot
+    std::vector<std::vector<WindowVertex>> window_buffers_;     // by draw slot
     std::vector<BinJob> jobs_;                         // every draw's, in submission order
     std::vector<detail::TileScratch> scratch_;         // by worker
     std::vector<FrameStats> worker_stats_;

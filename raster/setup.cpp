@@ -6,26 +6,45 @@
 
 namespace prast {
 
-SetupResult setup_triangle(const float* const clip[3], const std::uint32_t ref[3],
-                           int width, int height, bool cull_back, TriangleSetup& t,
-                           const SampleExtent& samples) {
-    // Project to window space (y down, conventions.md) and snap to 1/256 pixel.
-    // Double precision so that vertices far out in the guard band snap exactly.
-    std::int64_t fx[3], fy[3];
-    float z[3], inv_w[3];
+WindowVertex window_vertex(const float* clip, int width, int height) {
     // Callers clip to w > 0 and the guard band; a vertex outside them anyway
     // (a contract broken by hand) is refused rather than overflowing llrint.
     const double limit = 2.0 * kGuardBandPixels;
+    WindowVertex v;
+    const double w = clip[3];
+    const double x_win = (double(clip[0]) / w + 1.0) * 0.5 * width;
+    const double y_win = (1.0 - double(clip[1]) / w) * 0.5 * height;
+    if (!(w > 0.0) || !(std::fabs(x_win) <= limit) || !(std::fabs(y_win) <= limit)) return v;
+    v.x = std::int32_t(std::llrint(x_win * double(kSubPixelScale)));
+    v.y = std::int32_t(std::llrint(y_win * double(kSubPixelScale)));
+    v.z = float((double(clip[2]) / w + 1.0) * 0.5);
+    v.inv_w = float(1.0 / w);
+    v.ok = true;
+    return v;
+}
+
+SetupResult setup_triangle(const float* const clip[3], const std::uint32_t ref[3],
+                           int width, int height, bool cull_back, TriangleSetup& t,
+                           const SampleExtent& samples) {
+    WindowVertex wv[3];
     for (int i = 0; i < 3; ++i) {
-        double w = clip[i][3];
-        double x_win = (double(clip[i][0]) / w + 1.0) * 0.5 * width;
-        double y_win = (1.0 - double(clip[i][1]) / w) * 0.5 * height;
-        if (!(w > 0.0) || !(std::fabs(x_win) <= limit) || !(std::fabs(y_win) <= limit))
-            return SetupResult::Degenerate;
-        fx[i] = std::llrint(x_win * double(kSubPixelScale));
-        fy[i] = std::llrint(y_win * double(kSubPixelScale));
-        z[i] = float((double(clip[i][2]) / w + 1.0) * 0.5);
-        inv_w[i] = float(1.0 / w);
+        wv[i] = window_vertex(clip[i], width, height);
+        if (!wv[i].ok) return SetupResult::Degenerate;
+    }
+    const WindowVertex* const v[3] = {&wv[0], &wv[1], &wv[2]};
+    return setup_triangle(v, ref, width, height, cull_back, t, samples);
+}
+
+SetupResult setup_triangle(const WindowVertex* const v[3], const std::uint32_t ref[3], int width, int height,
+                           bool cull_back, TriangleSetup& t, const SampleExtent& samples) {
+    std::int64_t fx[3], fy[3];
+    float z[3], inv_w[3];
+    for (int i = 0; i < 3; ++i) {
+        if (!v[i]->ok) return SetupResult::Degenerate;
+        fx[i] = v[i]->x;
+        fy[i] = v[i]->y;
+        z[i] = v[i]->z;
+        inv_w[i] = v[i]->inv_w;
     }
 
     // Twice the signed area, exact. Front faces wind counter-clockwise in NDC

@@ -40,6 +40,22 @@ struct TriangleSetup {
 
 enum class SetupResult { Ok, CulledBack, Degenerate };
 
+// A vertex projected to window space (y down) and snapped to 1/256 pixel, in
+// double precision so that vertices far out in the guard band snap exactly:
+// what setup needs of it. The vertex pass projects every vertex once; only
+// vertices made by clipping are projected during setup.
+struct WindowVertex {
+    std::int32_t x = 0, y = 0;  // 1/256 pixel: |x|, |y| <= 2^29 when ok
+    float z = 0.0f;             // window depth
+    float inv_w = 0.0f;         // 1 / clip w
+    bool ok = false;            // w > 0 and within twice the guard band; setup refuses others
+};
+WindowVertex window_vertex(const float* clip, int width, int height);
+
+// The same setup from projected vertices (window_vertex()).
+SetupResult setup_triangle(const WindowVertex* const v[3], const std::uint32_t ref[3], int width, int height,
+                           bool cull_back, TriangleSetup& t, const SampleExtent& samples);
+
 // clip[i] points at the clip-space xyzw of vertex i (w > 0, within the guard band).
 // `samples` widens the pixel box to the pixels any sample of which may be
 // covered (the default, one sample at the centre, gives the centre box).

@@ -6,7 +6,9 @@
 
 #include <cstdint>
 
+#include "raster/clip.h"
 #include "raster/observer.h"
+#include "raster/setup.h"
 
 namespace prast {
 
@@ -22,5 +24,15 @@ void shade_vertices(const Program& program, std::uint32_t begin, std::uint32_t e
         if constexpr (Observer::enabled) obs.vertex(v, o, o + 4, Program::kVaryings);
     }
 }
+
+// A vertex with a non-finite coordinate: its triangles are dropped (invalid).
+constexpr std::uint32_t kVertexNotFinite = 1u << 15;
+
+// What binning and setup need of each shaded vertex, once per vertex rather
+// than once per triangle corner: for vertices [begin, end) (`stride` floats
+// each, clip xyzw first), codes[v] = outcode() or kVertexNotFinite, and
+// window[v] = window_vertex() (used by triangles that need no clipping).
+void project_vertices(const float* vertices, int stride, std::uint32_t begin, std::uint32_t end,
+                      const GuardBand& gb, int width, int height, std::uint16_t* codes, WindowVertex* window);
 
 } // namespace prast
