@@ -6,7 +6,6 @@
 // per-job stage: assemble, clip, cull, set up, bin.
 #pragma once
 
-#include <cmath>
 #include <cstdint>
 #include <vector>
 

@@ -116,7 +116,7 @@ public:
     std::size_t tri_count = 0;
     std::vector<float>* vertices = nullptr;  // post-vertex-shader, stride floats each
     std::vector<std::uint16_t>* outcodes = nullptr;  // project_vertices() of each vertex
-    std::vector<WindowVertex>* window = nullptr;
+    std::vector<WindowVertex>* window = nullptr;     // ... and its window position
     int first_job = 0, job_count = 0;
 };
 
@@ -175,8 +175,9 @@ private:
 };
 
 // One worker's tile-local storage, reused tile after tile: the samples of a
-// multisampled or transient tile, the winner of each sample (kNoWinner between tiles), a
-// dirty bit per 4x4 block holding winners, and the tile's winning triangles.
+// multisampled or transient tile, the winner of each sample (kNoWinner
+// between tiles), a dirty bit per 4x4 block holding winners, and the tile's
+// winning triangles.
 struct TileScratch {
     struct Ref {
         DrawRecord* draw;
