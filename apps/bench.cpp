@@ -639,7 +639,8 @@ int side_by_side(const std::vector<std::string>& exes, const std::vector<Workloa
     for (const Workload& w : list) {
         std::vector<double> whole[2], frame[2], textures[2];
         for (int i = 0; i < runs; ++i)
-            for (int e = 0; e < 2; ++e) {
+            for (int k = 0; k < 2; ++k) {
+                const int e = i % 2 == 0 ? k : 1 - k;  // which runs first alternates too
                 std::vector<std::string> argv = {exes[std::size_t(e)]};
                 for (const std::string& a : render_args(w)) argv.push_back(a);
                 if (msaa[e]) argv.insert(argv.end(), {"--msaa", std::to_string(samples)});
@@ -659,10 +660,15 @@ int side_by_side(const std::vector<std::string>& exes, const std::vector<Workloa
         const Summary wa = summarise(whole[0]), wb = summarise(whole[1]);
         const Summary fa = summarise(frame[0]), fb = summarise(frame[1]);
         const Summary ta = summarise(textures[0]), tb = summarise(textures[1]);
+        // Each round's ratio as well: the two frames of a round ran a few
+        // seconds apart, so a change in the machine's speed reaches both.
+        std::vector<double> rounds;
+        for (int i = 0; i < runs; ++i) rounds.push_back(frame[0][std::size_t(i)] / frame[1][std::size_t(i)]);
+        const Summary fr = summarise(rounds);
         std::printf("%-8s whole process A %.1f ms B %.1f ms (A/B %.2fx) | frame median A %.2f ms B %.2f ms "
-                    "(A/B %.2fx) | textures A %.1f ms B %.1f ms\n",
+                    "(A/B %.2fx; rounds %.2fx, %.2fx..%.2fx) | textures A %.1f ms B %.1f ms\n",
                     w.name.c_str(), wa.median, wb.median, wa.median / wb.median, fa.median, fb.median,
-                    fa.median / fb.median, ta.median, tb.median);
+                    fa.median / fb.median, fr.median, fr.min, fr.max, ta.median, tb.median);
         std::fflush(stdout);
     }
     fs::remove(out_png);
