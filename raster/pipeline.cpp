@@ -75,6 +75,7 @@ void Renderer::begin(Framebuffer& fb, const FrameOptions& options) {
         throw std::invalid_argument("samples per pixel must be 1, 2, 4 or 8");
     fb_ = &fb;
     options_ = options;
+    options_.transient = options.transient && options.clear;  // a frame that loads the target keeps it
     grid_ = TileGrid(fb.width, fb.height, tile_size_);
     draws_.clear();
 }
@@ -174,7 +175,7 @@ void Renderer::finish(TileHook hook, void* user) {
     const std::size_t plane = std::size_t(tile_size_) * std::size_t(tile_size_);
     const int blocks = (tile_size_ / kBlockSize) * (tile_size_ / kBlockSize);
     if (scratch_.size() != std::size_t(workers)) scratch_.resize(std::size_t(workers));
-    const bool transient = options_.transient && options_.clear;
+    const bool transient = options_.transient;
     // A transient tile no draw reaches shows S cleared samples resolved: the
     // clear colour, or infinities where the sums overflow (resolve.cpp).
     float uniform_color[4];
@@ -231,7 +232,7 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     c.dirty = sc.dirty.data();
     c.blocks_x = T / kBlockSize;
     TileTarget& tg = c.target;
-    const bool transient = options_.transient && options_.clear;
+    const bool transient = options_.transient;
     if (S == 1 && !transient) {
         tg.color = fb.has_color() ? fb.color.data() : nullptr;
         tg.depth = fb.depth.data();
