@@ -186,7 +186,6 @@ struct TileScratch {
     };
     std::vector<float> color, depth;
     std::vector<float> resolved;  // transient frames, several samples: the averages
-    std::vector<float> uniform;   // transient frames: a tile of the clear colour
     std::vector<std::uint32_t> winner;
     std::vector<std::uint64_t> dirty;
     std::vector<Ref> refs;

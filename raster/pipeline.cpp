@@ -192,11 +192,14 @@ void Renderer::finish(TileHook hook, void* user) {
             sc.depth.resize(plane * std::size_t(S));
             sc.color.resize(fb_->has_color() ? plane * std::size_t(S) * 4 : 0);
         }
-        if (transient && fb_->has_color()) {
-            if (S > 1) sc.resolved.resize(plane * 4);
-            sc.uniform.resize(plane * 4);
-            for (std::size_t i = 0; i < plane * 4; i += 4) std::memcpy(&sc.uniform[i], uniform_color, sizeof uniform_color);
-        }
+        if (transient && fb_->has_color() && S > 1) sc.resolved.resize(plane * 4);
+    }
+    // One tile of that colour for every worker (read only in the pass),
+    // refilled when the colour or the tile size changes.
+    if (transient && fb_->has_color() &&
+        (uniform_tile_.size() != plane * 4 || std::memcmp(uniform_tile_.data(), uniform_color, sizeof uniform_color))) {
+        uniform_tile_.resize(plane * 4);
+        for (std::size_t i = 0; i < plane * 4; i += 4) std::memcpy(&uniform_tile_[i], uniform_color, sizeof uniform_color);
     }
     worker_stats_.assign(std::size_t(workers), FrameStats{});
     pool_.reset_usage();
@@ -277,7 +280,7 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     if (options_.clear) {
         // Streamed at one sample, where it measured faster on 2 threads (bench
         // --alternate, bottle); with several samples the difference was in the noise.
-        if (uniform && transient) {}  // the hook sees sc.uniform
+        if (uniform && transient) {}  // the hook sees uniform_tile_
         else if (uniform && direct && S == 1) clear_tile_streaming(fb, r, options_.clear_color, options_.clear_depth);
         else if (direct) clear_tile(fb, r, options_.clear_color, options_.clear_depth);
         else clear_samples(tg.color, tg.depth, T, S, options_.clear_color, options_.clear_depth);
@@ -384,7 +387,7 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
             v.row = std::size_t(fb.width) * 4;
         } else {
             if (uniform) {
-                v.rgba = sc.uniform.data();
+                v.rgba = uniform_tile_.data();
             } else if (S == 1) {
                 v.rgba = tg.color;
             } else {

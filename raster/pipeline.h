@@ -136,6 +136,7 @@ private:
     std::vector<std::vector<WindowVertex>> window_buffers_;     // by draw slot
     std::vector<BinJob> jobs_;                         // every draw's, in submission order
     std::vector<detail::TileScratch> scratch_;         // by worker
+    std::vector<float> uniform_tile_;                  // transient frames: a tile of the resolved clear colour
     std::vector<FrameStats> worker_stats_;
     std::vector<std::uint32_t> frame_entries_;         // per tile, this frame
     std::vector<int> tile_order_;

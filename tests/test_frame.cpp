@@ -558,6 +558,34 @@ TEST_CASE("frame: a transient frame hands the hook the same colours and leaves t
             }
 }
 
+TEST_CASE("frame: a renderer's transient frames show each frame's own clear colour") {
+    // The tile of the clear colour that empty transient tiles hand over is
+    // kept between frames: a new colour, sample count or tile must refill it.
+    Renderer r({2, 16});
+    Framebuffer fb(40, 20);
+    for (int samples : {1, 4})
+        for (float green : {0.5f, 0.25f, 0.25f}) {
+            CAPTURE(samples);
+            CAPTURE(green);
+            FrameOptions o = frame_options(FrameOptions::Visibility::Auto, samples);
+            o.transient = true;
+            o.clear_color[1] = green;
+            int wrong = 0, pixels = 0;
+            std::mutex m;
+            r.begin(fb, o);
+            r.end([&](const TileView& v) {
+                std::lock_guard<std::mutex> lock(m);
+                CHECK(v.uniform);
+                for (int y = 0; y < v.height; ++y)
+                    for (int x = 0; x < v.width; ++x, ++pixels)
+                        for (int c = 0; c < 4; ++c)
+                            wrong += v.rgba[std::size_t(y) * v.row + 4 * std::size_t(x) + std::size_t(c)] != o.clear_color[c];
+            });
+            CHECK(pixels == 40 * 20);
+            CHECK(wrong == 0);
+        }
+}
+
 TEST_CASE("frame: misuse is refused") {
     Renderer r({1, 16});
     Framebuffer fb(8, 8);
