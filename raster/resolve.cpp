@@ -101,6 +101,17 @@ inline void resolve_row(const float* color, const float* depth, std::size_t plan
     }
 }
 
+// resolve_row for the frame's sample count.
+inline void resolve_row_of(int samples, const float* color, const float* depth, std::size_t plane, int width,
+                           float* out_color, float* out_depth) {
+    switch (samples) {
+    case 2: resolve_row<2>(color, depth, plane, width, out_color, out_depth); break;
+    case 4: resolve_row<4>(color, depth, plane, width, out_color, out_depth); break;
+    case 8: resolve_row<8>(color, depth, plane, width, out_color, out_depth); break;
+    default: resolve_row<1>(color, depth, plane, width, out_color, out_depth); break;
+    }
+}
+
 } // namespace
 
 void resolve_samples(const float* color, const float* depth, int size, int samples, const TileRect& r,
@@ -112,13 +123,7 @@ void resolve_samples(const float* color, const float* depth, int size, int sampl
         const float* c = color ? color + src * 4 : nullptr;
         float* oc = fb.has_color() ? &fb.color[dst * 4] : nullptr;
         if (!oc) c = nullptr;
-        float* od = &fb.depth[dst];
-        switch (samples) {
-        case 2: resolve_row<2>(c, depth + src, plane, r.width(), oc, od); break;
-        case 4: resolve_row<4>(c, depth + src, plane, r.width(), oc, od); break;
-        case 8: resolve_row<8>(c, depth + src, plane, r.width(), oc, od); break;
-        default: resolve_row<1>(c, depth + src, plane, r.width(), oc, od); break;
-        }
+        resolve_row_of(samples, c, depth + src, plane, r.width(), oc, &fb.depth[dst]);
     }
 }
 
@@ -126,12 +131,7 @@ void resolve_samples_local(const float* color, int size, int samples, int width,
     const std::size_t plane = std::size_t(size) * std::size_t(size);
     for (int y = 0; y < height; ++y) {
         const std::size_t at = std::size_t(y) * std::size_t(size) * 4;
-        switch (samples) {
-        case 2: resolve_row<2>(color + at, nullptr, plane, width, out + at, nullptr); break;
-        case 4: resolve_row<4>(color + at, nullptr, plane, width, out + at, nullptr); break;
-        case 8: resolve_row<8>(color + at, nullptr, plane, width, out + at, nullptr); break;
-        default: resolve_row<1>(color + at, nullptr, plane, width, out + at, nullptr); break;
-        }
+        resolve_row_of(samples, color + at, nullptr, plane, width, out + at, nullptr);
     }
 }
 
