@@ -15,6 +15,25 @@ double thread_cpu_ms() {
     return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
 }
 
+// Adds the calling thread's CPU and wall time from construction to
+// destruction to `u` (also when a task throws through it).
+class UsageTimer {
+public:
+    explicit UsageTimer(ThreadPool::Usage& u) : u_(u), t0_(Clock::now()), c0_(thread_cpu_ms()) {}
+    ~UsageTimer() {
+        u_.cpu_ms += thread_cpu_ms() - c0_;
+        u_.busy_ms += std::chrono::duration<double, std::milli>(Clock::now() - t0_).count();
+    }
+    UsageTimer(const UsageTimer&) = delete;
+    UsageTimer& operator=(const UsageTimer&) = delete;
+
+private:
+    using Clock = std::chrono::steady_clock;
+    ThreadPool::Usage& u_;
+    Clock::time_point t0_;
+    double c0_;
+};
+
 } // namespace
 
 ThreadPool::ThreadPool(int threads) : requested_(threads < 1 ? 1 : threads) {
@@ -65,13 +84,8 @@ ThreadPool::Usage ThreadPool::usage() const {
 void ThreadPool::reset_usage() { usage_.assign(usage_.size(), Usage{}); }
 
 void ThreadPool::work_measured(int worker) {
-    using Clock = std::chrono::steady_clock;
-    const auto t0 = Clock::now();
-    const double c0 = thread_cpu_ms();
+    UsageTimer timer(usage_[std::size_t(worker)]);
     work(worker);
-    Usage& u = usage_[std::size_t(worker)];
-    u.cpu_ms += thread_cpu_ms() - c0;
-    u.busy_ms += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
 void ThreadPool::work(int worker) {
@@ -93,18 +107,7 @@ void ThreadPool::work(int worker) {
 void ThreadPool::run(int count, const std::function<void(int, int)>& fn) {
     if (count <= 0) return;
     if (workers_.empty() || count == 1) {
-        using Clock = std::chrono::steady_clock;
-        const auto t0 = Clock::now();
-        const double c0 = thread_cpu_ms();
-        struct Account {  // also when a task throws
-            Usage& u;
-            Clock::time_point t0;
-            double c0;
-            ~Account() {
-                u.cpu_ms += thread_cpu_ms() - c0;
-                u.busy_ms += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-            }
-        } account{usage_[0], t0, c0};
+        UsageTimer timer(usage_[0]);
         for (int t = 0; t < count; ++t) fn(t, 0);
         return;
     }
