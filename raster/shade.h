@@ -184,7 +184,6 @@ inline void write_color(float* color, std::size_t row, std::uint32_t mask, const
             }
         }
     }
-    return;
 #else
     if (mask == 0xFFFFu) {
         for (int l = 0; l < kBlockLanes; l += 2) {
@@ -194,12 +193,12 @@ inline void write_color(float* color, std::size_t row, std::uint32_t mask, const
         }
         return;
     }
-#endif
     for (std::uint32_t m = mask; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         float* c = color + lane_offset_in(row, l) * 4;
         c[0] = out.r[l]; c[1] = out.g[l]; c[2] = out.b[l]; c[3] = out.a[l];
     }
+#endif
 }
 
 inline void count_quads(FrameStats& stats, std::uint32_t lanes) {
