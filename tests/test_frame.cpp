@@ -156,6 +156,32 @@ std::uint64_t render_frame(const OverdrawScene& sc, int threads, int tile, Frame
     return hash_framebuffer(fb);
 }
 
+// What a frame's tile hook was handed (it runs on the worker threads): each
+// pixel's RGBA, how many times the pixel came, and the uniform tiles.
+struct HookCapture {
+    int W, H;
+    std::vector<float> seen;
+    std::vector<int> count;
+    int uniform_tiles = 0;
+    std::mutex m;
+    HookCapture(int w, int h) : W(w), H(h), seen(std::size_t(w) * std::size_t(h) * 4, -7.0f), count(std::size_t(w) * std::size_t(h), 0) {}
+    void operator()(const TileView& v) {
+        std::lock_guard<std::mutex> lock(m);
+        uniform_tiles += v.uniform;
+        for (int y = 0; y < v.height; ++y)
+            for (int x = 0; x < v.width; ++x) {
+                const std::size_t p = std::size_t(v.y0 + y) * std::size_t(W) + std::size_t(v.x0 + x);
+                ++count[p];
+                std::memcpy(&seen[p * 4], &v.rgba[std::size_t(y) * v.row + 4 * std::size_t(x)], 4 * sizeof(float));
+            }
+    }
+    int not_once() const {
+        int n = 0;
+        for (int c : count) n += c != 1;
+        return n;
+    }
+};
+
 } // namespace
 
 TEST_SUITE("frame") {
@@ -379,24 +405,12 @@ TEST_CASE("frame: the tile hook sees every pixel once, with its final colour") {
             CAPTURE(tile);
             Renderer r({3, tile});
             Framebuffer fb(sc.W, sc.H);
-            std::vector<float> seen(fb.color.size(), -1.0f);
-            std::vector<int> count(std::size_t(sc.W) * sc.H, 0);
-            std::mutex m;
+            HookCapture hook(sc.W, sc.H);
             r.begin(fb, frame_options(FrameOptions::Visibility::Auto, samples));
             sc.submit(r);
-            r.end([&](const TileView& v) {
-                std::lock_guard<std::mutex> lock(m);
-                for (int y = 0; y < v.height; ++y)
-                    for (int x = 0; x < v.width; ++x) {
-                        const std::size_t p = std::size_t(v.y0 + y) * sc.W + std::size_t(v.x0 + x);
-                        ++count[p];
-                        for (int c = 0; c < 4; ++c) seen[p * 4 + std::size_t(c)] = v.rgba[std::size_t(y) * v.row + 4 * std::size_t(x) + std::size_t(c)];
-                    }
-            });
-            int not_once = 0;
-            for (int n : count) not_once += n != 1;
-            CHECK(not_once == 0);
-            CHECK(seen == fb.color);
+            r.end(hook);
+            CHECK(hook.not_once() == 0);
+            CHECK(hook.seen == fb.color);
         }
     }
 }
@@ -510,50 +524,36 @@ TEST_CASE("frame: a transient frame hands the hook the same colours and leaves t
                 CAPTURE(variant);
                 CAPTURE(samples);
                 CAPTURE(tile);
-                std::vector<float> views[2];
+                HookCapture kept(sc.W, sc.H), transient(sc.W, sc.H);
+                HookCapture* hooks[2] = {&kept, &transient};
                 Framebuffer fbs[2] = {Framebuffer(sc.W, sc.H), Framebuffer(sc.W, sc.H)};
                 fbs[1].clear(-1.0f, -2.0f, -3.0f, -4.0f, 0.5f);
                 const Framebuffer before = fbs[1];
-                int uniform_tiles = 0;
-                for (int transient = 0; transient < 2; ++transient) {
+                for (int t = 0; t < 2; ++t) {
                     Renderer r({3, tile});
                     FrameOptions o = frame_options(FrameOptions::Visibility::Auto, samples);
-                    o.transient = transient == 1;
+                    o.transient = t == 1;
                     if (variant == 1) o.clear_fill = fill;
                     if (variant == 2) o.clear_color[1] = 3e38f;
-                    std::vector<float>& seen = views[transient];
-                    seen.assign(std::size_t(sc.W) * sc.H * 4, -7.0f);
-                    std::vector<int> count(std::size_t(sc.W) * sc.H, 0);
-                    std::mutex m;
-                    r.begin(fbs[transient], o);
+                    r.begin(fbs[t], o);
                     if (variant == 2) {  // one corner triangle: most tiles stay uniform
                         PaintProgram p{sc.clip.data(), sc.var.data(), false, 1.0f};
                         r.submit(p, std::uint32_t(sc.clip.size()), corner.data(), corner.size());
                     } else {
                         sc.submit(r);
                     }
-                    r.end([&](const TileView& v) {
-                        std::lock_guard<std::mutex> lock(m);
-                        uniform_tiles += transient && v.uniform;
-                        for (int y = 0; y < v.height; ++y)
-                            for (int x = 0; x < v.width; ++x) {
-                                const std::size_t p = std::size_t(v.y0 + y) * sc.W + std::size_t(v.x0 + x);
-                                ++count[p];
-                                std::memcpy(&seen[p * 4], &v.rgba[std::size_t(y) * v.row + 4 * std::size_t(x)], 4 * sizeof(float));
-                            }
-                    });
-                    int not_once = 0;
-                    for (int n : count) not_once += n != 1;
-                    CHECK(not_once == 0);
+                    r.end(*hooks[t]);
+                    CHECK(hooks[t]->not_once() == 0);
                 }
-                CHECK(std::memcmp(views[0].data(), views[1].data(), views[0].size() * sizeof(float)) == 0);
-                CHECK(std::memcmp(views[0].data(), fbs[0].color.data(), views[0].size() * sizeof(float)) == 0);
+                const std::size_t bytes = kept.seen.size() * sizeof(float);
+                CHECK(std::memcmp(kept.seen.data(), transient.seen.data(), bytes) == 0);
+                CHECK(std::memcmp(kept.seen.data(), fbs[0].color.data(), bytes) == 0);
                 CHECK(fbs[1].color == before.color);
                 CHECK(fbs[1].depth == before.depth);
                 if (variant == 2) {
-                    CHECK(uniform_tiles > (tile == 16 ? 40 : 2));
-                    CHECK(views[1].back() == 1.0f);  // alpha
-                    CHECK(std::isinf(views[1][views[1].size() - 3]) == (samples > 1));
+                    CHECK(transient.uniform_tiles > (tile == 16 ? 40 : 2));
+                    CHECK(transient.seen.back() == 1.0f);  // alpha
+                    CHECK(std::isinf(transient.seen[transient.seen.size() - 3]) == (samples > 1));
                 }
             }
 }
@@ -570,18 +570,13 @@ TEST_CASE("frame: a renderer's transient frames show each frame's own clear colo
             FrameOptions o = frame_options(FrameOptions::Visibility::Auto, samples);
             o.transient = true;
             o.clear_color[1] = green;
-            int wrong = 0, pixels = 0;
-            std::mutex m;
+            HookCapture hook(40, 20);
             r.begin(fb, o);
-            r.end([&](const TileView& v) {
-                std::lock_guard<std::mutex> lock(m);
-                CHECK(v.uniform);
-                for (int y = 0; y < v.height; ++y)
-                    for (int x = 0; x < v.width; ++x, ++pixels)
-                        for (int c = 0; c < 4; ++c)
-                            wrong += v.rgba[std::size_t(y) * v.row + 4 * std::size_t(x) + std::size_t(c)] != o.clear_color[c];
-            });
-            CHECK(pixels == 40 * 20);
+            r.end(hook);
+            CHECK(hook.not_once() == 0);
+            CHECK(hook.uniform_tiles == 3 * 2);  // 16x16 tiles
+            int wrong = 0;
+            for (std::size_t i = 0; i < hook.seen.size(); ++i) wrong += hook.seen[i] != o.clear_color[i % 4];
             CHECK(wrong == 0);
         }
 }
