@@ -54,6 +54,19 @@ struct FragmentBlock {
 #pragma GCC diagnostic pop
 };
 
+// Batches. A program may also define
+//   void fragment_batch(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out, int count) const;
+// and the rasterizer then hands it up to kMaxBatchBlocks sparse blocks of one
+// draw at once (of one triangle or several), with at most kBlockLanes live
+// lanes together, so that a program packing live lanes into vectors fills
+// them where small triangles leave most of each block dead. Each in[i] is the
+// block fragment() would be handed and out[i] must be what fragment() writes
+// for it. A block with more than kBatchBlockLanes live lanes is shaded alone
+// unless it fills up a batch. Batched draws are those whose Observer is
+// disabled and that never discard (DrawState::may_discard false).
+constexpr int kMaxBatchBlocks = 8;
+constexpr int kBatchBlockLanes = 8;
+
 struct FragmentOut {
     alignas(64) float r[kBlockLanes];
     alignas(64) float g[kBlockLanes];

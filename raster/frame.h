@@ -85,7 +85,24 @@ struct has_fragment<P, std::void_t<decltype(std::declval<const P&>().fragment(
                            std::declval<const FragmentBlock<P::kVaryings>&>(), std::declval<FragmentOut&>()))>>
     : std::true_type {};
 
+// A program with fragment_batch() (fragment.h) takes sparse blocks in batches.
+template <class P, class = void>
+struct has_fragment_batch : std::false_type {};
+template <class P>
+struct has_fragment_batch<P, std::void_t<decltype(std::declval<const P&>().fragment_batch(
+                                 std::declval<const FragmentBlock<P::kVaryings>* const*>(),
+                                 std::declval<FragmentOut* const*>(), 0))>> : std::true_type {};
+
 namespace detail {
+
+// A winner's block waiting to be shaded in a batch.
+struct WinnerBlock {
+    const TriangleSetup* tri;
+    const BinJob* job;
+    int bx, by;
+    std::uint32_t lanes;
+    std::uint32_t won[kMaxSamples];
+};
 
 enum class DrawMode : std::uint8_t {
     Visible,    // visibility pass, winners shaded once
@@ -103,13 +120,21 @@ public:
     // (kNoWinner for depth only).
     virtual void rasterize_visible(const TriangleSetup& t, TileContext& c, std::uint32_t winner) = 0;
     virtual void rasterize_in_order(const TriangleSetup& t, const BinJob& job, TileContext& c) = 0;
+    // Triangles items[begin, end) of a job in order, sparse blocks batched
+    // (draws with `batches`).
+    virtual void rasterize_in_order_batched(const BinJob& job, std::uint32_t begin, std::uint32_t end,
+                                            TileContext& c) = 0;
     virtual void shade_winner(const TriangleSetup& t, const BinJob& job, TileContext& c, int bx, int by,
                               std::uint32_t lanes, const std::uint32_t* won) = 0;
+    // Sparse winner blocks of this draw, one batch (count <= kMaxBatchBlocks,
+    // kBlockLanes lanes together; draws with `batches`).
+    virtual void shade_winners(const WinnerBlock* blocks, int count, TileContext& c) = 0;
 
     DrawState state;
     DrawMode mode = DrawMode::InOrder;
     bool reads_color = false;   // blends with the target: winners must be shaded first
     bool observed = false;      // its observer is enabled
+    bool batches = false;       // sparse blocks shaded in batches: fragment_batch(), not observed, never discards
     int stride = 4;
     std::uint32_t vertex_count = 0;
     const std::uint32_t* indices = nullptr;
@@ -144,6 +169,15 @@ public:
         if (c.sample_count() == 1) in_order<false>(t, job, c);
         else in_order<true>(t, job, c);
     }
+    void rasterize_in_order_batched(const BinJob& job, std::uint32_t begin, std::uint32_t end,
+                                    TileContext& c) override {
+        if (c.sample_count() == 1) in_order_batched<false>(job, begin, end, c);
+        else in_order_batched<true>(job, begin, end, c);
+    }
+    void shade_winners(const WinnerBlock* blocks, int count, TileContext& c) override {
+        if (c.sample_count() == 1) winners_batched<false>(blocks, count, c);
+        else winners_batched<true>(blocks, count, c);
+    }
     void shade_winner(const TriangleSetup& t, const BinJob& job, TileContext& c, int bx, int by,
                       std::uint32_t lanes, const std::uint32_t* won) override {
         if constexpr (has_fragment<Program>::value) {
@@ -167,6 +201,42 @@ private:
             });
         } else {
             (void)t; (void)job; (void)c;
+        }
+    }
+
+    template <bool MS>
+    void in_order_batched(const BinJob& job, std::uint32_t begin, std::uint32_t end, TileContext& c) {
+        if constexpr (has_fragment_batch<Program>::value) {
+            BlockBatch<Program::kVaryings> batch;
+            for (std::uint32_t i = begin; i < end; ++i) {
+                const TriangleSetup& t = job.setups[job.items[i]];
+                TriangleVaryings<Program::kVaryings> pv;
+                prepare_varyings<Program::kVaryings>(t, vertices->data(), job, pv);
+                for_each_block<MS>(t, c, *c.stats, [&](int bx, int by, BlockSamples& bs) {
+                    shade_in_order_batched<MS>(program_, state, t, pv, c, bx, by, bs, batch);
+                });
+            }
+            flush_batch<MS>(program_, batch, c, state.blend, true);
+        } else {
+            (void)job; (void)begin; (void)end; (void)c;
+        }
+    }
+
+    template <bool MS>
+    void winners_batched(const WinnerBlock* blocks, int count, TileContext& c) {
+        if constexpr (has_fragment_batch<Program>::value) {
+            BlockBatch<Program::kVaryings> batch;
+            for (int i = 0; i < count; ++i) {
+                const WinnerBlock& w = blocks[i];
+                TriangleVaryings<Program::kVaryings> pv;
+                prepare_varyings<Program::kVaryings>(*w.tri, vertices->data(), *w.job, pv);
+                const int k = batch.add(w.lanes);
+                fill_block<MS, Program::kVaryings>(*w.tri, pv, c, w.bx, w.by, w.lanes, nullptr, batch.in[k]);
+                for (int s = 0; s < samples_of<MS>(c); ++s) batch.write[k][s] = w.won[s];
+            }
+            flush_batch<MS>(program_, batch, c, Blend::Replace, false);
+        } else {
+            (void)blocks; (void)count; (void)c;
         }
     }
 

@@ -349,6 +349,10 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
                 pending = false;
                 flushed = true;
             }
+            if (d.batches && (d.mode == detail::DrawMode::InOrder || (d.mode == detail::DrawMode::Visible && !defer))) {
+                d.rasterize_in_order_batched(job, begin, end, c);
+                continue;
+            }
             for (std::uint32_t i = begin; i < end; ++i) {
                 const TriangleSetup& t = job.setups[job.items[i]];
                 switch (d.mode) {
@@ -407,6 +411,15 @@ void Renderer::flush_winners(TileContext& c, detail::TileScratch& sc) {
     const int S = c.sample_count();
     const TileTarget& tg = c.target;
     const std::size_t words = sc.dirty.size();
+    // Sparse winner blocks wait for a batch of their draw (winners own their
+    // samples, so the order of the writes does not matter).
+    detail::WinnerBlock batch[kMaxBatchBlocks];
+    detail::DrawRecord* batch_draw = nullptr;
+    int batch_count = 0, batch_lanes = 0;
+    auto flush_batch = [&] {
+        if (batch_count) batch_draw->shade_winners(batch, batch_count, c);
+        batch_count = batch_lanes = 0;
+    };
     for (std::size_t w = 0; w < words; ++w) {
         for (std::uint64_t bits = sc.dirty[w]; bits; bits &= bits - 1) {
             const int b = int(w * 64) + __builtin_ctzll(bits);
@@ -428,13 +441,30 @@ void Renderer::flush_winners(TileContext& c, detail::TileScratch& sc) {
                         lanes |= won[s];
                     }
                     const detail::TileScratch::Ref& ref = sc.refs[k];
-                    ref.draw->shade_winner(*ref.tri, *ref.job, c, bx, by, lanes, won);
+                    const int n = __builtin_popcount(lanes);
+                    const bool joins = batch_count && batch_draw == ref.draw && batch_count < kMaxBatchBlocks &&
+                                       batch_lanes + n <= kBlockLanes;
+                    if (!ref.draw->batches || (n > kBatchBlockLanes && !joins)) {
+                        ref.draw->shade_winner(*ref.tri, *ref.job, c, bx, by, lanes, won);
+                        continue;
+                    }
+                    if (!joins) flush_batch();
+                    detail::WinnerBlock& wb = batch[batch_count++];
+                    wb.tri = ref.tri;
+                    wb.job = ref.job;
+                    wb.bx = bx;
+                    wb.by = by;
+                    wb.lanes = lanes;
+                    for (int s = 0; s < S; ++s) wb.won[s] = won[s];
+                    batch_draw = ref.draw;
+                    batch_lanes += n;
                 }
                 detail::store_winner(win + s0 * tg.wplane, tg.wrow, 0xFFFFu, kNoWinner);
             }
         }
         sc.dirty[w] = 0;
     }
+    flush_batch();
     sc.refs.clear();
 }
 

@@ -4,6 +4,7 @@
 //   static constexpr int kVaryings;                        // floats per vertex after xyzw
 //   void vertex(std::uint32_t index, float clip[4], float* varyings) const;
 //   void fragment(const FragmentBlock<kVaryings>&, FragmentOut&) const;   // optional: none = depth only
+//   void fragment_batch(const FragmentBlock<kVaryings>* const*, FragmentOut* const*, int) const;  // optional
 //
 // Both are called through templates, never virtually. An Observer (observer.h)
 // sees each stage; the default NullObserver compiles to nothing.
@@ -171,6 +172,7 @@ void Renderer::submit(const Program& program, std::uint32_t vertex_count, const 
     }
     d->reads_color = fb_->has_color() && state.blend != Blend::Replace;
     d->observed = Observer::enabled;
+    d->batches = has_fragment_batch<Program>::value && !Observer::enabled && !state.may_discard;
     draws_.push_back(std::move(d));
 }
 

@@ -8,6 +8,10 @@
 //  - shade_winner(): the visibility pass already wrote depth and chose each
 //    sample's winner; this shades a winning triangle for the pixels it won
 //    (with the whole block's helper lanes, so derivatives are unchanged).
+// A program with fragment_batch() (fragment.h) gets sparse blocks several at
+// a time instead: BlockBatch collects them (shade_in_order_batched() for
+// draws that never discard, Draw::shade_winners() for winners) and
+// flush_batch() shades them with one call and writes them back in order.
 #pragma once
 
 #include <cstdint>
@@ -278,6 +282,125 @@ void shade_winner(const Program& program, const float* vertices, const BinJob& j
         const std::uint32_t m = won[s] & live;
         if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, Blend::Replace);
     }
+}
+
+// Sparse blocks of one draw waiting for one fragment_batch() call, each with
+// the samples it colours (write[i][s]).
+template <int NV>
+struct BlockBatch {
+    FragmentBlock<NV> in[kMaxBatchBlocks];
+    FragmentOut out[kMaxBatchBlocks];
+    std::uint32_t write[kMaxBatchBlocks][kMaxSamples];
+    int count = 0, lanes = 0;
+
+    bool fits(std::uint32_t mask) const {
+        return count < kMaxBatchBlocks && lanes + popcount16(mask) <= kBlockLanes;
+    }
+    bool holds_block(int bx, int by) const {
+        for (int i = 0; i < count; ++i)
+            if (in[i].x == bx && in[i].y == by) return true;
+        return false;
+    }
+    // The next block: the caller fills in[] and write[].
+    int add(std::uint32_t mask) {
+        lanes += popcount16(mask);
+        out[count].kill = 0;
+        return count++;
+    }
+};
+
+// The statistics and colour of one shaded block: samples write[s] of the
+// lanes the shader kept. `in_order`: also count kills and writes (the
+// visibility pass counted a winner's writes).
+template <bool MS>
+inline void write_block(TileContext& c, int bx, int by, std::uint32_t lanes, const FragmentOut& out,
+                        const std::uint32_t* write, Blend blend, bool in_order) {
+    FrameStats& stats = *c.stats;
+    const std::uint32_t live = lanes & ~out.kill;
+    count_quads(stats, lanes);
+    stats.fragments_shaded += popcount16(lanes);
+    if (in_order) {
+        stats.fragments_shader_killed += popcount16(lanes & out.kill);
+        stats.fragments_written += popcount16(live);
+    }
+    const TileTarget& tg = c.target;
+    if (!tg.color) return;
+    const std::size_t o = tg.offset(bx, by);
+    for (int s = 0; s < samples_of<MS>(c); ++s) {
+        const std::uint32_t m = write[s] & live;
+        if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, blend);
+    }
+}
+
+// Shades the batch with one call and writes its blocks back in the order
+// they were added (a later triangle's colour lands last), then empties it.
+template <bool MS, class Program>
+[[gnu::noinline]] void flush_batch(const Program& program, BlockBatch<Program::kVaryings>& batch, TileContext& c, Blend blend,
+                 bool in_order) {
+    if (!batch.count) return;
+    const FragmentBlock<Program::kVaryings>* in[kMaxBatchBlocks];
+    FragmentOut* out[kMaxBatchBlocks];
+    for (int i = 0; i < batch.count; ++i) {
+        in[i] = &batch.in[i];
+        out[i] = &batch.out[i];
+    }
+    program.fragment_batch(in, out, batch.count);
+    for (int i = 0; i < batch.count; ++i)
+        write_block<MS>(c, batch.in[i].x, batch.in[i].y, batch.in[i].mask, batch.out[i], batch.write[i], blend,
+                        in_order);
+    batch.count = 0;
+    batch.lanes = 0;
+}
+
+// A block's fragment inputs, as both callers above set them.
+template <bool MS, int NV>
+inline void fill_block(const TriangleSetup& t, const TriangleVaryings<NV>& pv, const TileContext& c, int bx, int by,
+                       std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in) {
+    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, lanes, centre, in);
+    in.x = bx;
+    in.y = by;
+    in.mask = lanes;
+    in.prim_id = t.prim_id;
+    in.front_facing = t.front_facing;
+}
+
+// shade_in_order() for a draw that never discards (DrawState::may_discard
+// false) and whose program takes batches: depth is tested and written at
+// once, since no shader may take a fragment back; a sparse block joins the
+// batch, a dense one is shaded alone (after the batch, if the batch holds its
+// pixels, so that colours land in submission order).
+template <bool MS, class Program>
+[[gnu::always_inline]] inline void shade_in_order_batched(const Program& program, const DrawState& st, const TriangleSetup& t,
+                            const TriangleVaryings<Program::kVaryings>& pv, TileContext& c, int bx, int by,
+                            BlockSamples& bs, BlockBatch<Program::kVaryings>& batch) {
+    constexpr int NV = Program::kVaryings;
+    test_depth<MS>(t, c, bx, by, st.depth_test, false, bs);
+    count_fragments(*c.stats, bs);
+    if (!bs.any_pass) return;
+    const TileTarget& tg = c.target;
+    const std::size_t o = tg.offset(bx, by);
+    for (int s = 0; s < samples_of<MS>(c); ++s) {
+        if (!bs.pass[s]) continue;
+        if (st.depth_write) store_block(tg.depth + o + s * tg.plane, tg.row, bs.pass[s], bs.z[s]);
+        if (tg.winner) store_winner(tg.winner + tg.winner_offset(bx, by) + s * tg.wplane, tg.wrow, bs.pass[s], kNoWinner);
+    }
+    const BlockSamples* centre = MS ? nullptr : &bs;
+    // A dense block fills up a batch it fits in (a triangle's half of a
+    // block and its neighbour's), or is shaded alone.
+    if (popcount16(bs.any_pass) > kBatchBlockLanes && !(batch.count && batch.fits(bs.any_pass))) {
+        if (batch.holds_block(bx, by)) flush_batch<MS>(program, batch, c, st.blend, true);
+        FragmentBlock<NV> in;
+        fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, in);
+        FragmentOut out;
+        out.kill = 0;
+        program.fragment(in, out);
+        write_block<MS>(c, bx, by, bs.any_pass, out, bs.pass, st.blend, true);
+        return;
+    }
+    if (!batch.fits(bs.any_pass)) flush_batch<MS>(program, batch, c, st.blend, true);
+    const int i = batch.add(bs.any_pass);
+    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, batch.in[i]);
+    for (int s = 0; s < samples_of<MS>(c); ++s) batch.write[i][s] = bs.pass[s];
 }
 
 } // namespace detail

@@ -18,19 +18,20 @@
 
 namespace prast {
 
-// The interpolated geometry of a block's lanes (SurfacePoint in structure-of-
-// arrays form). The uv derivatives belong to the 2x2 quads (fragment.h: x from
-// the quad's top row, y from its left column). With 16 lanes the block is
-// unpacked (lane l in quad l / 4); with 4 or 8, its live lanes are packed
-// first and quad[l] says which quad lane l came from.
+// The interpolated geometry of the lanes (SurfacePoint in structure-of-arrays
+// form). The uv derivatives belong to the 2x2 quads (fragment.h: x from the
+// quad's top row, y from its left column). With quad null, the 16 lanes are
+// one unpacked block (lane l in quad l / 4 of four); otherwise live lanes are
+// packed first, from one sparse block or several (of several triangles), and
+// quad[l] names lane l's quad, of up to kMaxQuadSlots.
 struct SurfaceLanes {
     const float *Px, *Py, *Pz;      // world position
     const float *Nx, *Ny, *Nz;      // interpolated vertex normal
     const float *Tx, *Ty, *Tz, *Tw; // tangent + handedness
     const float *u, *v;
     const std::uint8_t* quad = nullptr;
-    float dudx[4], dvdx[4], dudy[4], dvdy[4];  // per quad
-    bool front_facing = true;
+    float dudx[kMaxQuadSlots], dvdx[kMaxQuadSlots], dudy[kMaxQuadSlots], dvdy[kMaxQuadSlots];  // per quad
+    std::uint32_t back_facing = 0;  // lanes of back-facing triangles
 };
 
 namespace material_lanes_detail {
@@ -80,7 +81,7 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     if (maps[kBase] || maps[kMetalRough] || maps[kRough] || maps[kMetal] || maps[kNormal] || maps[kOcclusion] ||
         maps[kEmissive]) {
         std::uint32_t live_quads = 0;
-        if constexpr (N == kBlockLanes) {
+        if (!s.quad) {
             for (int q = 0; q < 4; ++q) live_quads |= std::uint32_t(((live >> (4 * q)) & 0xFu) != 0) << q;
         } else {
             for (int l = 0; l < N; ++l)
@@ -113,9 +114,11 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         for (int g = 0; g < groups; ++g) {
             // material_lods(): one lambda per quad with a live lane.
             const Texture& first = *group_tex[g][0];
-            float lambda[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-            for (int q = 0; q < 4; ++q)
-                if ((live_quads >> q) & 1u) lambda[q] = first.lod(s.dudx[q], s.dvdx[q], s.dudy[q], s.dvdy[q]);
+            float lambda[kMaxQuadSlots];
+            for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
+                const int q = __builtin_ctz(qs);
+                lambda[q] = first.lod(s.dudx[q], s.dvdx[q], s.dudy[q], s.dvdy[q]);
+            }
             TrilinearLanes at;
             prepare_trilinear_lanes<N>(first, s.u, s.v, lambda, s.quad, live, at);
             fetch_trilinear_lanes<N>(group_tex[g], group_size[g], at, group_out[g], group_used[g]);
@@ -186,16 +189,16 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     }
 
     // Geometric frame; a back face of a double-sided material flips all of it.
-    alignas(64) float Nx[N], Ny[N], Nz[N], zero[N], one[N];
+    alignas(64) float Nx[N], Ny[N], Nz[N], zero[N], one[N], flip[N];
     copy_lanes<N>(Nx, s.Nx); copy_lanes<N>(Ny, s.Ny); copy_lanes<N>(Nz, s.Nz);
     for (int l = 0; l < N; ++l) {
         zero[l] = 0.0f;
         one[l] = 1.0f;
+        flip[l] = ((s.back_facing >> l) & 1u) ? -1.0f : 1.0f;
     }
     safe_normalize_lanes<N>(Nx, Ny, Nz, zero, zero, one);
-    const float flip = s.front_facing ? 1.0f : -1.0f;
     for (int l = 0; l < N; ++l) {
-        mb.Nx[l] = Nx[l] * flip; mb.Ny[l] = Ny[l] * flip; mb.Nz[l] = Nz[l] * flip;
+        mb.Nx[l] = Nx[l] * flip[l]; mb.Ny[l] = Ny[l] * flip[l]; mb.Nz[l] = Nz[l] * flip[l];
         mb.Gx[l] = mb.Nx[l]; mb.Gy[l] = mb.Ny[l]; mb.Gz[l] = mb.Nz[l];
     }
     if (maps[kNormal]) {
@@ -229,9 +232,9 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         safe_normalize_lanes<N>(nx, ny, nz, Nx, Ny, Nz);
         for (int l = 0; l < N; ++l) {
             const bool use = mapped[l] != 0.0f;
-            mb.Nx[l] = use ? nx[l] * flip : mb.Nx[l];
-            mb.Ny[l] = use ? ny[l] * flip : mb.Ny[l];
-            mb.Nz[l] = use ? nz[l] * flip : mb.Nz[l];
+            mb.Nx[l] = use ? nx[l] * flip[l] : mb.Nx[l];
+            mb.Ny[l] = use ? ny[l] * flip[l] : mb.Ny[l];
+            mb.Nz[l] = use ? nz[l] * flip[l] : mb.Nz[l];
         }
     }
 

@@ -1,7 +1,9 @@
-// The PBR fragment stage; see pbr_program.h. One call per 4x4 block. The lit
-// image takes the 16-lane path (shade_lanes); debug views and conductor
-// materials loop over the lanes with the scalar sample_material() and
-// shade_surface() inlined, the functions the stepper explains pixels with.
+// The PBR fragment stage; see pbr_program.h. One call per 4x4 block, or per
+// batch of sparse blocks (raster/fragment.h). The lit image takes the lane
+// paths: a block's 16 lanes in place (shade_block), or the live lanes of one
+// or several blocks packed (shade_packed); debug views and conductor materials
+// loop over the lanes with the scalar sample_material() and shade_surface()
+// inlined, the functions the stepper explains pixels with.
 #include "shading/pbr_program.h"
 
 #include "shading/light_block.h"
@@ -9,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #if defined(__AVX2__)
 #include <immintrin.h>
@@ -46,87 +49,227 @@ BrdfTerms first_light_terms(const MaterialSample& ms, const SurfacePoint& sp, co
     return evaluate_brdf(bi, ctx.model);
 }
 
-} // namespace
-
-// The lit path (material_lanes.h, then light_block.h) for a block's live
-// lanes, either in place (N = 16) or packed into the first N = 4 or 8 lanes:
-// half the blocks of a typical frame have at most 4 live lanes (small
-// triangles, edges), and a lane costs the same whether live or not. Each lane
-// does the float operations of sample_material() and shade_surface().
-template <int N>
-void PbrProgram::shade_lanes(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
-    SurfaceLanes s;
-    const float* var[kVaryings];
-    std::uint32_t live = in.mask;
-    // Packed lane i holds block lane lane[i], of quad quad[i]; the spare
-    // packed lanes repeat the first live lane (valid inputs, results dropped).
-    std::uint8_t lane[N] = {}, quad[N] = {};
-    alignas(64) float packed[kVaryings][N];
-    if constexpr (N == kBlockLanes) {
-        for (int k = 0; k < kVaryings; ++k) var[k] = in.var[k];
-    } else {
-        static_assert(N == 4 || N == 8, "packed blocks have 4 or 8 lanes");
-        int n = 0;
-        for (std::uint32_t m = in.mask; m && n < N; m &= m - 1) lane[n++] = std::uint8_t(__builtin_ctz(m));
-        live = (1u << n) - 1u;
-        for (int l = n; l < N; ++l) lane[l] = lane[0];
-        for (int l = 0; l < N; ++l) quad[l] = std::uint8_t(lane[l] >> 2);
-#if defined(__AVX2__)
-        // Each varying: both halves permuted, then blended.
-        alignas(32) std::int32_t index[8];
-        for (int l = 0; l < 8; ++l) index[l] = lane[l < N ? l : 0];
-        const __m256i idx = _mm256_load_si256(reinterpret_cast<const __m256i*>(index));
-        const __m256 from_high = _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7)));
-        for (int k = 0; k < kVaryings; ++k) {
-            const __m256 lo = _mm256_permutevar8x32_ps(_mm256_load_ps(in.var[k]), idx);
-            const __m256 hi = _mm256_permutevar8x32_ps(_mm256_load_ps(in.var[k] + 8), idx);
-            const __m256 v = _mm256_blendv_ps(lo, hi, from_high);
-            if constexpr (N == 8) _mm256_store_ps(packed[k], v);
-            else _mm_store_ps(packed[k], _mm256_castps256_ps128(v));
-        }
-#else
-        for (int k = 0; k < kVaryings; ++k)
-            for (int l = 0; l < N; ++l) packed[k][l] = in.var[k][lane[l]];
-#endif
-        for (int k = 0; k < kVaryings; ++k) var[k] = packed[k];
-        s.quad = quad;
-    }
+// The varyings' arrays as the lit path's surface.
+void set_surface(SurfaceLanes& s, const float* const* var) {
     s.Px = var[kVarP]; s.Py = var[kVarP + 1]; s.Pz = var[kVarP + 2];
     s.Nx = var[kVarN]; s.Ny = var[kVarN + 1]; s.Nz = var[kVarN + 2];
     s.Tx = var[kVarT]; s.Ty = var[kVarT + 1]; s.Tz = var[kVarT + 2]; s.Tw = var[kVarT + 3];
     s.u = var[kVarUV]; s.v = var[kVarUV + 1];
+}
+
+// The lanes of mask m in order, as bytes, into out[0, 16) (zero past them).
+inline void list_lanes(std::uint32_t m, std::uint8_t* out) {
+#if defined(__BMI2__)
+    // Nibble l of `live` is 0xF for a live lane l; pext gathers those lanes'
+    // numbers from the nibble sequence 0..15, and pdep spreads them to bytes.
+    const std::uint64_t live = _pdep_u64(m, 0x1111111111111111ull) * 0xF;
+    const std::uint64_t lanes = _pext_u64(0xFEDCBA9876543210ull, live);
+    const std::uint64_t lo = _pdep_u64(lanes, 0x0F0F0F0F0F0F0F0Full);
+    const std::uint64_t hi = _pdep_u64(lanes >> 32, 0x0F0F0F0F0F0F0F0Full);
+    std::memcpy(out, &lo, 8);
+    std::memcpy(out + 8, &hi, 8);
+#else
+    std::memset(out, 0, 16);
+    for (int n = 0; m; m &= m - 1) out[n++] = std::uint8_t(__builtin_ctz(m));
+#endif
+}
+
+#if defined(__AVX2__) && defined(__BMI2__)
+// 0xFF in byte l (of eight) for each set bit l of m.
+inline std::uint64_t byte_mask(std::uint32_t m) { return _pdep_u64(m & 0xFFu, 0x0101010101010101ull) * 0xFF; }
+
+// Block lanes (eight, from lane h0) that are live in m, as int32 masks, and
+// for each its packed position: `next` for the first live one, then on.
+inline void unpack_positions(std::uint32_t m, int h0, int next, __m256i& live, __m256i& pos) {
+    const std::uint64_t bytes = byte_mask(m >> h0);
+    const std::uint64_t seq = 0x0706050403020100ull + std::uint64_t(next) * 0x0101010101010101ull;
+    live = _mm256_cvtepi8_epi32(_mm_cvtsi64_si128(std::int64_t(bytes)));
+    pos = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(std::int64_t(_pdep_u64(seq, bytes))));
+}
+
+// The eight packed values src[pos] (pos < 16; src holds 8 or 16 floats).
+template <int N>
+inline __m256 take_packed(const float* src, __m256i pos) {
+    const __m256 lo = _mm256_permutevar8x32_ps(_mm256_load_ps(src), pos);
+    if constexpr (N <= 8) return lo;
+    const __m256 hi = _mm256_permutevar8x32_ps(_mm256_load_ps(src + 8), pos);
+    return _mm256_blendv_ps(lo, hi, _mm256_castsi256_ps(_mm256_cmpgt_epi32(pos, _mm256_set1_epi32(7))));
+}
+#endif
+
+// packed[k][i] = in[b]->var[k][lane[i]] for the packed lanes i in
+// [first[b], first[b + 1]) of each block b, then the spare lanes up to N
+// repeat the last live one. Rows hold N + 8 floats: with AVX2 each block's
+// lanes are stored eight at a time, spilling into the next block's (written
+// after) or the spare lanes (written last).
+template <int N>
+void pack_lanes(const FragmentBlock<kPbrVaryings>* const* in, int count, const std::uint8_t* first,
+                const std::uint8_t* lane, float (*packed)[N + 8]) {
+    const int n = first[count];
+#if defined(__AVX2__)
+    for (int b = 0; b < count; ++b) {
+        for (int j = first[b]; j < first[b + 1]; j += 8) {
+            // Both halves of each varying permuted, then blended. Past the
+            // block's lanes the bytes are another block's or zero: any lane
+            // will do there.
+            const __m256i idx = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(lane + j)));
+            const __m256 from_high = _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7)));
+            for (int k = 0; k < kPbrVaryings; ++k) {
+                const __m256 lo = _mm256_permutevar8x32_ps(_mm256_load_ps(in[b]->var[k]), idx);
+                const __m256 hi = _mm256_permutevar8x32_ps(_mm256_load_ps(in[b]->var[k] + 8), idx);
+                _mm256_storeu_ps(packed[k] + j, _mm256_blendv_ps(lo, hi, from_high));
+            }
+        }
+    }
+#else
+    for (int b = 0; b < count; ++b)
+        for (int i = first[b]; i < first[b + 1]; ++i)
+            for (int k = 0; k < kPbrVaryings; ++k) packed[k][i] = in[b]->var[k][lane[i]];
+#endif
+    for (int k = 0; k < kPbrVaryings; ++k)
+        for (int i = n; i < N; ++i) packed[k][i] = packed[k][n - 1];
+}
+
+} // namespace
+
+// The lit path (material_lanes.h, then light_block.h) for all 16 lanes of a
+// block in place. Each lane does the float operations of sample_material()
+// and shade_surface().
+void PbrProgram::shade_block(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
+    SurfaceLanes s;
+    const float* var[kVaryings];
+    for (int k = 0; k < kVaryings; ++k) var[k] = in.var[k];
+    set_surface(s, var);
     for (int q = 0; q < 4; ++q) {
         const int l = 4 * q;  // the quad's derivatives, as surface_point() takes them
         s.dudx[q] = in.ddx(kVarUV, l); s.dvdx[q] = in.ddx(kVarUV + 1, l);
         s.dudy[q] = in.ddy(kVarUV, l); s.dvdy[q] = in.ddy(kVarUV + 1, l);
     }
-    s.front_facing = in.front_facing;
+    s.back_facing = in.front_facing ? 0u : 0xFFFFu;
+
+    MaterialBlock mb;
+    out.kill = sample_material_lanes<kBlockLanes>(*material, s, in.mask, mb);
+    RadianceBlock rb;
+    shade_block_lanes<kBlockLanes>(mb, *ctx, rb);
+    const bool blend = material->m->alpha_mode == AlphaMode::Blend;
+    for (int l = 0; l < kBlockLanes; ++l) {
+        out.r[l] = rb.r[l]; out.g[l] = rb.g[l]; out.b[l] = rb.b[l]; out.a[l] = blend ? mb.alpha[l] : 1.0f;
+    }
+}
+
+// The lit path for the live lanes of `count` blocks, packed into the first N
+// (4, 8 or 16): half the blocks of a typical frame have at most 4 live lanes
+// (small triangles, edges), and a lane costs the same whether live or not.
+// Each (block, quad) with a live lane gets a quad slot of its own, with its
+// derivatives; the spare packed lanes repeat the last live lane (valid
+// inputs, results dropped).
+template <int N>
+void PbrProgram::shade_packed(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out, int count) const {
+    static_assert(N == 4 || N == 8 || N == 16, "packed calls have 4, 8 or 16 lanes");
+    SurfaceLanes s;
+    // lane[i], quad[i]: packed lane i's block lane and quad slot; each block
+    // writes 16 bytes from its first lane on, the next block overwriting the excess.
+    std::uint8_t lane[kBlockLanes + 16], quad[kBlockLanes + 16], first[kMaxBatchBlocks + 1];
+    int n = 0, slots = 0;
+    for (int b = 0; b < count; ++b) {
+        const FragmentBlock<kVaryings>& B = *in[b];
+        alignas(16) std::uint8_t slot_of[16] = {};
+        for (int q = 0; q < 4; ++q) {
+            if (!B.quad_live(q)) continue;
+            slot_of[q] = std::uint8_t(slots);
+            s.dudx[slots] = B.ddx(kVarUV, 4 * q); s.dvdx[slots] = B.ddx(kVarUV + 1, 4 * q);
+            s.dudy[slots] = B.ddy(kVarUV, 4 * q); s.dvdy[slots] = B.ddy(kVarUV + 1, 4 * q);
+            ++slots;
+        }
+        first[b] = std::uint8_t(n);
+        list_lanes(B.mask, lane + n);
+        const int nb = __builtin_popcount(B.mask);
+#if defined(__AVX2__)
+        // quad[i] = slot_of[lane[i] / 4], sixteen at a time.
+        const __m128i q = _mm_and_si128(_mm_srli_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(lane + n)), 2),
+                                        _mm_set1_epi8(3));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(quad + n),
+                         _mm_shuffle_epi8(_mm_load_si128(reinterpret_cast<const __m128i*>(slot_of)), q));
+#else
+        for (int i = n; i < n + nb; ++i) quad[i] = slot_of[lane[i] >> 2];
+#endif
+        if (!B.front_facing) s.back_facing |= ((1u << nb) - 1u) << n;
+        n += nb;
+    }
+    first[count] = std::uint8_t(n);
+    const std::uint32_t live = (1u << n) - 1u;
+    for (int l = n; l < N; ++l) quad[l] = quad[n - 1];
+    s.back_facing |= ((s.back_facing >> (n - 1)) & 1u) * (((1u << N) - 1u) & ~live);
+
+    alignas(64) float packed[kVaryings][N + 8];
+    const float* var[kVaryings];
+    pack_lanes<N>(in, count, first, lane, packed);
+    for (int k = 0; k < kVaryings; ++k) var[k] = packed[k];
+    set_surface(s, var);
+    s.quad = quad;
 
     MaterialBlock mb;
     const std::uint32_t kill = sample_material_lanes<N>(*material, s, live, mb);
     RadianceBlock rb;
     shade_block_lanes<N>(mb, *ctx, rb);
 
-    // Alpha: the blend weight of BLEND materials (README "Transparency"), 1 otherwise.
+    // Back to each block's lanes (0, 0, 0, 1 in its dead lanes). Alpha: the
+    // blend weight of BLEND materials (README "Transparency"), 1 otherwise.
     const bool blend = material->m->alpha_mode == AlphaMode::Blend;
-    if constexpr (N == kBlockLanes) {
-        out.kill = kill;
-        for (int l = 0; l < N; ++l) {
-            out.r[l] = rb.r[l]; out.g[l] = rb.g[l]; out.b[l] = rb.b[l]; out.a[l] = blend ? mb.alpha[l] : 1.0f;
+    for (int b = 0; b < count; ++b) {
+        FragmentOut& o = *out[b];
+        const std::uint32_t m = in[b]->mask;
+        const int nb = first[b + 1] - first[b];
+#if defined(__AVX2__) && defined(__BMI2__)
+        o.kill = _pdep_u32((kill >> first[b]) & ((1u << nb) - 1u), m);
+        int next = first[b];
+        for (int h = 0; h < kBlockLanes; h += 8) {
+            __m256i live_lanes, pos;
+            unpack_positions(m, h, next, live_lanes, pos);
+            next += __builtin_popcount((m >> h) & 0xFFu);
+            const __m256 keep = _mm256_castsi256_ps(live_lanes);
+            _mm256_store_ps(o.r + h, _mm256_and_ps(take_packed<N>(rb.r, pos), keep));
+            _mm256_store_ps(o.g + h, _mm256_and_ps(take_packed<N>(rb.g, pos), keep));
+            _mm256_store_ps(o.b + h, _mm256_and_ps(take_packed<N>(rb.b, pos), keep));
+            _mm256_store_ps(o.a + h, blend ? _mm256_blendv_ps(_mm256_set1_ps(1.0f), take_packed<N>(mb.alpha, pos), keep)
+                                           : _mm256_set1_ps(1.0f));
         }
-    } else {
-        std::fill(out.r, out.r + kBlockLanes, 0.0f);
-        std::fill(out.g, out.g + kBlockLanes, 0.0f);
-        std::fill(out.b, out.b + kBlockLanes, 0.0f);
-        std::fill(out.a, out.a + kBlockLanes, 1.0f);
-        std::uint32_t block_kill = 0;
-        for (std::uint32_t m = live; m; m &= m - 1) {
-            const int i = __builtin_ctz(m), l = lane[i];
-            out.r[l] = rb.r[i]; out.g[l] = rb.g[i]; out.b[l] = rb.b[i]; out.a[l] = blend ? mb.alpha[i] : 1.0f;
-            block_kill |= ((kill >> i) & 1u) << l;
+#else
+        std::fill(o.r, o.r + kBlockLanes, 0.0f);
+        std::fill(o.g, o.g + kBlockLanes, 0.0f);
+        std::fill(o.b, o.b + kBlockLanes, 0.0f);
+        std::fill(o.a, o.a + kBlockLanes, 1.0f);
+        o.kill = 0;
+        for (int i = first[b]; i < first[b] + nb; ++i) {
+            const int l = lane[i];
+            o.r[l] = rb.r[i]; o.g[l] = rb.g[i]; o.b[l] = rb.b[i]; o.a[l] = blend ? mb.alpha[i] : 1.0f;
+            o.kill |= ((kill >> i) & 1u) << l;
         }
-        out.kill = block_kill;
+#endif
     }
+}
+
+bool PbrProgram::lit_lanes() const {
+    const bool reference = ctx->env && ctx->ibl == IblMode::Reference;
+    return (view == DebugView::None || view == DebugView::Tiles) && material->m->conductor == Conductor::None &&
+           !reference;
+}
+
+void PbrProgram::fragment_batch(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out,
+                                int count) const {
+    if (!lit_lanes()) {
+        for (int b = 0; b < count; ++b) fragment(*in[b], *out[b]);
+        return;
+    }
+    int live = 0;
+    for (int b = 0; b < count; ++b) live += __builtin_popcount(in[b]->mask);
+    if (live > kBlockLanes) {  // more than one call's lanes: not a batch the rasterizer makes
+        for (int b = 0; b < count; ++b) fragment(*in[b], *out[b]);
+        return;
+    }
+    if (live > 8) shade_packed<16>(in, out, count);
+    else if (live > 4) shade_packed<8>(in, out, count);
+    else shade_packed<4>(in, out, count);
 }
 
 void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
@@ -134,12 +277,14 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
     // The lit path samples the material and lights the lanes together, packed
     // when few are live; debug views, conductor materials and the reference
     // integral of the environment go lane by lane.
-    const bool reference = ctx->env && ctx->ibl == IblMode::Reference;
-    if ((view == DebugView::None || view == DebugView::Tiles) && m.conductor == Conductor::None && !reference) {
-        const int live = __builtin_popcount(in.mask);
-        if (live > 8) shade_lanes<16>(in, out);
-        else if (live > 4) shade_lanes<8>(in, out);
-        else shade_lanes<4>(in, out);
+    if (lit_lanes()) {
+        if (__builtin_popcount(in.mask) > 8) {
+            shade_block(in, out);
+        } else {
+            const FragmentBlock<kVaryings>* b = &in;
+            FragmentOut* o = &out;
+            fragment_batch(&b, &o, 1);
+        }
         return;
     }
 

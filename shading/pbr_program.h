@@ -55,10 +55,15 @@ struct PbrProgram {
     }
 
     void fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const;
+    // Several sparse blocks at once (raster/fragment.h): the same bytes as
+    // fragment() on each.
+    void fragment_batch(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out, int count) const;
 
 private:
+    bool lit_lanes() const;
+    void shade_block(const FragmentBlock<kVaryings>& in, FragmentOut& out) const;
     template <int N>
-    void shade_lanes(const FragmentBlock<kVaryings>& in, FragmentOut& out) const;
+    void shade_packed(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out, int count) const;
 };
 
 } // namespace prast

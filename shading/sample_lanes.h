@@ -62,6 +62,9 @@ inline bool same_sampling_layout(const Texture& a, const Texture& b) {
            a.wrap_t() == b.wrap_t();
 }
 
+// Quads a packed call may draw its lanes from: a live lane each at most.
+constexpr int kMaxQuadSlots = kBlockLanes;
+
 namespace sample_lanes_detail {
 
 constexpr int kMaxN = kBlockLanes;
@@ -351,34 +354,35 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
 } // namespace sample_lanes_detail
 
 // Prepares the first N lanes: u and v hold their coordinates, lambda[q] the
-// level of detail of quad q (Texture::lod of its uv derivatives), quad[l] the
-// quad of lane l when N < 16 (the lanes of a sparse block packed first); with
-// N = 16 the block is unpacked and lane l lies in quad l / 4. Only the lanes in
-// `live` are fetched later, but every lane gets valid indices (reduce() folds
-// any coordinate).
+// level of detail of quad q (Texture::lod of its uv derivatives). With quad
+// null, N = 16 and the block is unpacked: lane l lies in quad l / 4 of four.
+// Otherwise the lanes are packed (the live lanes of one or several sparse
+// blocks first) and quad[l] < kMaxQuadSlots names lane l's quad. Only the
+// lanes in `live` are fetched later, but every lane gets valid indices
+// (reduce() folds any coordinate).
 template <int N = kBlockLanes>
-inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const float* v, const float lambda[4],
+inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const float* v, const float* lambda,
                                     const std::uint8_t* quad, std::uint32_t live, TrilinearLanes& out) {
     using namespace sample_lanes_detail;
     static_assert(N % 4 == 0 && N <= kMaxN, "whole vectors of lanes");
-    constexpr bool unpacked = N == kMaxN;
-    auto quad_of = [quad](int l) { return unpacked ? l >> 2 : int(quad[l]); };
+    const bool unpacked = !quad;
+    auto quad_of = [quad](int l) { return quad ? int(quad[l]) : l >> 2; };
 
     // The level choice of Texture::trilinear_wrapped(), once per quad with a
     // live lane: level A alone, or A and B = A + 1 blended by t.
     std::uint32_t live_quads = 0;
-    if constexpr (unpacked) {
+    if (unpacked) {
         for (int q = 0; q < 4; ++q) live_quads |= std::uint32_t(((live >> (4 * q)) & 0xFu) != 0) << q;
     } else {
         for (int l = 0; l < N; ++l)
             if ((live >> l) & 1u) live_quads |= 1u << quad_of(l);
     }
-    int la[4] = {0, 0, 0, 0};
-    float t[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    int la[kMaxQuadSlots] = {};
+    float t[kMaxQuadSlots] = {};
     std::uint32_t blend_quads = 0;
     const int last = tex.levels() - 1;
-    for (int q = 0; q < 4; ++q) {
-        if (!((live_quads >> q) & 1u)) continue;
+    for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
+        const int q = __builtin_ctz(qs);
         const float lam = lambda[q];
         if (!(lam > 0.0f)) {
             la[q] = 0;  // magnification, or NaN
@@ -393,7 +397,7 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
     }
     out.live = live;
     out.blend = 0;
-    if constexpr (unpacked) {
+    if (unpacked) {
         for (int q = 0; q < 4; ++q) {
             for (int l = 4 * q; l < 4 * q + 4; ++l) out.t[l] = t[q];
             out.blend |= ((blend_quads >> q) & 1u) * (0xFu << (4 * q));
@@ -409,9 +413,10 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
     // Per-lane level sizes; usually all quads read the same levels.
     bool uniform = true;
     const int q0 = live_quads ? __builtin_ctz(live_quads) : 0;
-    for (int q = q0 + 1; q < 4; ++q)
-        if ((live_quads >> q) & 1u)
-            uniform &= la[q] == la[q0] && ((blend_quads >> q) & 1u) == ((blend_quads >> q0) & 1u);
+    for (std::uint32_t qs = live_quads & (live_quads - 1); qs; qs &= qs - 1) {
+        const int q = __builtin_ctz(qs);
+        uniform &= la[q] == la[q0] && ((blend_quads >> q) & 1u) == ((blend_quads >> q0) & 1u);
+    }
     LevelLanes A, B;
     if (uniform) {
         A.set(tex, la[q0], 0, N);

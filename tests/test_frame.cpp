@@ -6,6 +6,7 @@
 // sees every pixel once with its final colour; bad frame use is refused.
 #include <doctest/doctest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -48,6 +49,25 @@ struct PaintProgram {
             if (discard && std::fmod(std::fabs(in.var[0][l] * 7.0f + in.var[1][l] * 5.0f), 1.0f) < 0.3f)
                 out.kill |= 1u << l;
         }
+    }
+};
+
+// What the batch-taking program below saw.
+struct BatchCounters {
+    std::atomic<int> several{0};  // batches of more than one block
+    std::atomic<int> broken{0};   // batches breaking fragment.h's promises
+};
+
+// PaintProgram that takes sparse blocks in batches (fragment.h), shading each
+// block as fragment() does.
+struct BatchPaintProgram : PaintProgram {
+    BatchCounters* counters = nullptr;
+    void fragment_batch(const FragmentBlock<3>* const* in, FragmentOut* const* out, int count) const {
+        int lanes = 0;
+        for (int b = 0; b < count; ++b) lanes += __builtin_popcount(in[b]->mask);
+        if (count < 1 || count > kMaxBatchBlocks || lanes > kBlockLanes) ++counters->broken;
+        if (count > 1) ++counters->several;
+        for (int b = 0; b < count; ++b) fragment(*in[b], *out[b]);
     }
 };
 
@@ -111,10 +131,19 @@ struct OverdrawScene {
         }
     }
 
-    void submit(Renderer& r) const {
+    // batch: submit the batch-taking program, counting into it.
+    void submit(Renderer& r, BatchCounters* batch = nullptr) const {
         for (const Draw& d : draws) {
             if (d.depth_only) {
                 DepthProgram p{clip.data()};
+                r.submit(p, std::uint32_t(clip.size()), d.idx.data(), d.idx.size(), d.state);
+            } else if (batch) {
+                BatchPaintProgram p;
+                p.clip = clip.data();
+                p.varyings = var.data();
+                p.discard = d.discard;
+                p.alpha = d.alpha;
+                p.counters = batch;
                 r.submit(p, std::uint32_t(clip.size()), d.idx.data(), d.idx.size(), d.state);
             } else {
                 PaintProgram p{clip.data(), var.data(), d.discard, d.alpha};
@@ -145,12 +174,12 @@ FrameOptions frame_options(FrameOptions::Visibility v, int samples = 1) {
 }
 
 std::uint64_t render_frame(const OverdrawScene& sc, int threads, int tile, FrameOptions::Visibility v,
-                           FrameStats* stats = nullptr, int samples = 1) {
+                           FrameStats* stats = nullptr, int samples = 1, BatchCounters* batch = nullptr) {
     Renderer r({threads, tile});
     Framebuffer fb(sc.W, sc.H);
     r.begin_frame();
     r.begin(fb, frame_options(v, samples));
-    sc.submit(r);
+    sc.submit(r, batch);
     r.end();
     if (stats) *stats = r.stats();
     return hash_framebuffer(fb);
@@ -224,6 +253,31 @@ TEST_CASE("visibility: byte-identical to shading in order, each visible pixel sh
         CHECK(in_order.fragments_depth_killed > 10000u);
         // Through the visibility pass far fewer fragments were shaded.
         CHECK(visible.fragments_shaded * 2 < in_order.fragments_shaded);
+    }
+}
+
+TEST_CASE("batches: sparse blocks shaded together give the bytes and counts of block by block") {
+    for (bool blending : {false, true}) {
+        const OverdrawScene sc(256, 160, 21 + blending, blending);
+        for (int samples : {1, 4})
+            for (auto v : {FrameOptions::Visibility::Auto, FrameOptions::Visibility::Always,
+                           FrameOptions::Visibility::Never}) {
+                CAPTURE(blending);
+                CAPTURE(samples);
+                CAPTURE(int(v));
+                FrameStats plain, batched;
+                BatchCounters counters;
+                const std::uint64_t ref = render_frame(sc, 1, 64, v, &plain, samples);
+                CHECK(render_frame(sc, 2, 32, v, &batched, samples, &counters) == ref);
+                CHECK(counters.broken == 0);
+                CHECK(counters.several > 100);
+                CHECK(batched.fragments_covered == plain.fragments_covered);
+                CHECK(batched.fragments_depth_killed == plain.fragments_depth_killed);
+                CHECK(batched.fragments_shaded == plain.fragments_shaded);
+                CHECK(batched.fragments_shader_killed == plain.fragments_shader_killed);
+                CHECK(batched.fragments_written == plain.fragments_written);
+                CHECK(batched.quads_shaded == plain.quads_shaded);
+            }
     }
 }
 

@@ -212,7 +212,7 @@ void check_material(std::uint32_t seed) {
         s.dudx[q] = var[6][l + 1] - var[6][l]; s.dvdx[q] = var[7][l + 1] - var[7][l];
         s.dudy[q] = var[6][l + 2] - var[6][l]; s.dvdy[q] = var[7][l + 2] - var[7][l];
     }
-    s.front_facing = front;
+    s.back_facing = front ? 0u : 0xFFFFu;
 
     MaterialBlock mb;
     const std::uint32_t kill = sample_material_lanes<N>(bm, s, pk.live, mb);
@@ -248,54 +248,75 @@ void check_material(std::uint32_t seed) {
     }
 }
 
+// A random PBR program (textured or not, alpha MASK or opaque) and random
+// blocks for it.
+struct ProgramFixture {
+    Texture albedo, normal, orm;
+    Material m;
+    BoundMaterial bm;
+    ShadingContext ctx;
+    PbrProgram prog;
+
+    ProgramFixture(std::mt19937& rng, BrdfModel model)
+        : albedo(random_texture(rng, 32, 32, Wrap::Repeat, Wrap::Repeat)),
+          normal(random_texture(rng, 32, 32, Wrap::Repeat, Wrap::Repeat)),
+          orm(random_texture(rng, 16, 64, Wrap::MirroredRepeat, Wrap::ClampToEdge)) {
+        std::uniform_real_distribution<float> uni(0.0f, 1.0f), sym(-1.0f, 1.0f);
+        std::uniform_int_distribution<int> coin(0, 1);
+        m.base_color_factor = {uni(rng), uni(rng), uni(rng), uni(rng)};
+        m.metallic_factor = uni(rng);
+        m.roughness_factor = uni(rng);
+        m.alpha_mode = coin(rng) ? AlphaMode::Mask : AlphaMode::Opaque;
+        m.alpha_cutoff = 0.3f * uni(rng);
+        bm.m = &m;
+        if (coin(rng)) {
+            bm.base_color = &albedo;
+            bm.normal = &normal;
+            bm.metallic_roughness = &orm;
+        }
+        ctx.eye = {sym(rng), 2.0f, 5.0f};
+        ctx.model = model;
+        add_test_lights(ctx, rng);
+        prog.material = &bm;
+        prog.ctx = &ctx;
+    }
+    ProgramFixture(const ProgramFixture&) = delete;
+
+    // Random varyings, uv with gradients `scale` times the usual (so that
+    // blocks differ in level of detail), `live` lanes at random places.
+    static void random_block(std::mt19937& rng, int live, float scale, FragmentBlock<kPbrVaryings>& in) {
+        std::uniform_real_distribution<float> uni(0.0f, 1.0f), sym(-1.0f, 1.0f);
+        std::uniform_int_distribution<int> coin(0, 1);
+        for (int l = 0; l < kBlockLanes; ++l) {
+            for (int k = 0; k < kPbrVaryings; ++k) in.var[k][l] = sym(rng);
+            in.var[kVarUV][l] = 0.3f + scale * 0.02f * float(lane_x(l)) + 0.001f * sym(rng);
+            in.var[kVarUV + 1][l] = 0.6f + scale * 0.03f * float(lane_y(l)) + 0.001f * sym(rng);
+            in.z[l] = uni(rng);
+        }
+        std::vector<int> order(kBlockLanes);
+        for (int l = 0; l < kBlockLanes; ++l) order[std::size_t(l)] = l;
+        std::shuffle(order.begin(), order.end(), rng);
+        in.mask = 0;
+        for (int i = 0; i < live; ++i) in.mask |= 1u << order[std::size_t(i)];
+        in.front_facing = coin(rng);
+    }
+};
+
 // PbrProgram::fragment() on a block with a random coverage mask (so that it
 // takes the 4-, 8- or 16-lane path) against sample_material() and
 // shade_surface() lane by lane.
 void check_program(std::uint32_t seed, BrdfModel model) {
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> uni(0.0f, 1.0f), sym(-1.0f, 1.0f);
-    std::uniform_int_distribution<int> coin(0, 1), count(1, 16);
-    const Texture albedo = random_texture(rng, 32, 32, Wrap::Repeat, Wrap::Repeat);
-    const Texture normal = random_texture(rng, 32, 32, Wrap::Repeat, Wrap::Repeat);
-    const Texture orm = random_texture(rng, 16, 64, Wrap::MirroredRepeat, Wrap::ClampToEdge);
-    Material m;
-    m.base_color_factor = {uni(rng), uni(rng), uni(rng), uni(rng)};
-    m.metallic_factor = uni(rng);
-    m.roughness_factor = uni(rng);
-    m.alpha_mode = coin(rng) ? AlphaMode::Mask : AlphaMode::Opaque;
-    m.alpha_cutoff = 0.3f * uni(rng);
-    BoundMaterial bm;
-    bm.m = &m;
-    if (coin(rng)) {
-        bm.base_color = &albedo;
-        bm.normal = &normal;
-        bm.metallic_roughness = &orm;
-    }
-    ShadingContext ctx;
-    ctx.eye = {sym(rng), 2.0f, 5.0f};
-    ctx.model = model;
-    add_test_lights(ctx, rng);
-
-    PbrProgram prog;
-    prog.material = &bm;
-    prog.ctx = &ctx;
+    std::uniform_int_distribution<int> count(1, 16);
+    ProgramFixture f(rng, model);
+    const BoundMaterial& bm = f.bm;
+    const Material& m = f.m;
     FragmentBlock<kPbrVaryings> in;
-    for (int l = 0; l < kBlockLanes; ++l) {
-        for (int k = 0; k < kPbrVaryings; ++k) in.var[k][l] = sym(rng);
-        in.var[kVarUV][l] = 0.3f + 0.02f * float(lane_x(l)) + 0.001f * sym(rng);
-        in.var[kVarUV + 1][l] = 0.6f + 0.03f * float(lane_y(l)) + 0.001f * sym(rng);
-        in.z[l] = uni(rng);
-    }
-    // Live lanes: a random count at random places.
-    std::vector<int> order(kBlockLanes);
-    for (int l = 0; l < kBlockLanes; ++l) order[std::size_t(l)] = l;
-    std::shuffle(order.begin(), order.end(), rng);
     const int n = count(rng);
-    for (int i = 0; i < n; ++i) in.mask |= 1u << order[std::size_t(i)];
-    in.front_facing = coin(rng);
+    ProgramFixture::random_block(rng, n, 1.0f, in);
 
     FragmentOut out;
-    prog.fragment(in, out);
+    f.prog.fragment(in, out);
     MaterialLods lods;
     for (int l = 0; l < kBlockLanes; ++l) {
         if (!((in.mask >> l) & 1u)) continue;
@@ -306,13 +327,65 @@ void check_program(std::uint32_t seed, BrdfModel model) {
         const bool killed = m.alpha_mode == AlphaMode::Mask && !(ms.alpha >= m.alpha_cutoff);
         CHECK(((out.kill >> l) & 1u) == (killed ? 1u : 0u));
         if (killed) continue;
-        const glm::vec3 ref = shade_surface(ms, sp, ctx);
+        const glm::vec3 ref = shade_surface(ms, sp, f.ctx);
         CHECK(bits(out.r[l]) == bits(ref.r));
         CHECK(bits(out.g[l]) == bits(ref.g));
         CHECK(bits(out.b[l]) == bits(ref.b));
         CHECK(out.a[l] == 1.0f);
     }
     CHECK((out.kill & ~in.mask) == 0u);
+}
+
+// PbrProgram::fragment_batch() on up to kMaxBatchBlocks blocks (each its own
+// facing, level of detail and coverage; some with centroid-moved lanes, whose
+// derivatives come from centre_var) against fragment() on each block: every
+// lane's output and every kill, bit for bit.
+void check_batch(std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<int> blocks_pick(1, kMaxBatchBlocks), coin(0, 3);
+    std::uniform_real_distribution<float> scale_pick(0.2f, 40.0f);
+    ProgramFixture f(rng, BrdfModel::Default);
+    if (coin(rng) == 0) f.m.alpha_mode = AlphaMode::Blend;  // alpha comes back through the batch too
+    const int count = blocks_pick(rng);
+    std::vector<FragmentBlock<kPbrVaryings>> in(static_cast<std::size_t>(kMaxBatchBlocks));
+    int budget = kBlockLanes - count;  // one live lane each, then the rest at random
+    for (int b = 0; b < count; ++b) {
+        std::uniform_int_distribution<int> extra(0, std::min(budget, kBlockLanes - 1));
+        const int live = 1 + extra(rng);
+        budget -= live - 1;
+        FragmentBlock<kPbrVaryings>& B = in[std::size_t(b)];
+        ProgramFixture::random_block(rng, live, scale_pick(rng), B);
+        B.centroid_mask = 0;
+        if (coin(rng) == 0) {  // a multisampled block: centroids moved the live lanes a little
+            std::memcpy(B.centre_var, B.var, sizeof B.var);
+            B.centroid_mask = B.mask;
+            for (int l = 0; l < kBlockLanes; ++l)
+                if ((B.mask >> l) & 1u) B.var[kVarUV][l] += 0.003f;
+        }
+    }
+    std::vector<FragmentOut> batched(static_cast<std::size_t>(kMaxBatchBlocks)), alone(static_cast<std::size_t>(kMaxBatchBlocks));
+    const FragmentBlock<kPbrVaryings>* ins[kMaxBatchBlocks];
+    FragmentOut* outs[kMaxBatchBlocks];
+    for (int b = 0; b < count; ++b) {
+        ins[b] = &in[std::size_t(b)];
+        outs[b] = &batched[std::size_t(b)];
+        batched[std::size_t(b)].kill = 0;
+        alone[std::size_t(b)].kill = 0;
+        f.prog.fragment(in[std::size_t(b)], alone[std::size_t(b)]);
+    }
+    f.prog.fragment_batch(ins, outs, count);
+    for (int b = 0; b < count; ++b) {
+        const FragmentOut &x = batched[std::size_t(b)], &y = alone[std::size_t(b)];
+        INFO("seed ", seed, " blocks ", count, " block ", b, " mask ", in[std::size_t(b)].mask);
+        CHECK(x.kill == y.kill);
+        for (int l = 0; l < kBlockLanes; ++l) {
+            if (!((in[std::size_t(b)].mask >> l) & 1u)) continue;
+            CHECK(bits(x.r[l]) == bits(y.r[l]));
+            CHECK(bits(x.g[l]) == bits(y.g[l]));
+            CHECK(bits(x.b[l]) == bits(y.b[l]));
+            CHECK(bits(x.a[l]) == bits(y.a[l]));
+        }
+    }
 }
 
 } // namespace
@@ -353,6 +426,10 @@ TEST_CASE("the lit fragment path (4, 8 or 16 lanes) equals the scalar functions 
         check_program(seed, BrdfModel::Default);
         check_program(seed, BrdfModel::Gltf);
     }
+}
+
+TEST_CASE("a batch of sparse blocks shades each block as fragment() does, bit for bit") {
+    for (std::uint32_t seed = 1; seed <= 1500; ++seed) check_batch(seed);
 }
 
 TEST_CASE("block material sampling equals sample_material bit for bit") {
