@@ -209,6 +209,8 @@ private:
         if constexpr (has_fragment_batch<Program>::value) {
             BlockBatch<Program::kVaryings> batch;
             for (std::uint32_t i = begin; i < end; ++i) {
+                if (i + 2 < end) prefetch_setup(job.setups[job.items[i + 2]]);
+                if (i + 1 < end) prefetch_varyings(job.setups[job.items[i + 1]], vertices->data(), job, stride);
                 const TriangleSetup& t = job.setups[job.items[i]];
                 TriangleVaryings<Program::kVaryings> pv;
                 prepare_varyings<Program::kVaryings>(t, vertices->data(), job, pv);
@@ -227,6 +229,7 @@ private:
         if constexpr (has_fragment_batch<Program>::value) {
             BlockBatch<Program::kVaryings> batch;
             for (int i = 0; i < count; ++i) {
+                if (i + 1 < count) prefetch_varyings(*blocks[i + 1].tri, vertices->data(), *blocks[i + 1].job, stride);
                 const WinnerBlock& w = blocks[i];
                 TriangleVaryings<Program::kVaryings> pv;
                 prepare_varyings<Program::kVaryings>(*w.tri, vertices->data(), *w.job, pv);

@@ -354,6 +354,9 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
                 continue;
             }
             for (std::uint32_t i = begin; i < end; ++i) {
+                if (i + 2 < end) detail::prefetch_setup(job.setups[job.items[i + 2]]);
+                if (i + 1 < end && !(d.mode == detail::DrawMode::Visible && defer) && d.mode != detail::DrawMode::DepthOnly)
+                    detail::prefetch_varyings(job.setups[job.items[i + 1]], d.vertices->data(), job, d.stride);
                 const TriangleSetup& t = job.setups[job.items[i]];
                 switch (d.mode) {
                 case detail::DrawMode::Visible:
@@ -449,6 +452,7 @@ void Renderer::flush_winners(TileContext& c, detail::TileScratch& sc) {
                         continue;
                     }
                     if (!joins) flush_batch();
+                    detail::prefetch_setup(*ref.tri);  // read when the batch is shaded
                     detail::WinnerBlock& wb = batch[batch_count++];
                     wb.tri = ref.tri;
                     wb.job = ref.job;

@@ -53,6 +53,25 @@ inline void prepare_varyings(const TriangleSetup& t, const float* vertices, cons
     }
 }
 
+// Asks the cache for a triangle's setup (first) and then, once that has
+// arrived, its vertices' varyings: the triangles of a tile come in
+// submission order from anywhere in the draw's arrays, and waiting for them
+// is a good part of a frame of small triangles.
+inline void prefetch_setup(const TriangleSetup& t) {
+    const char* p = reinterpret_cast<const char*>(&t);
+    for (std::size_t o = 0; o < sizeof t; o += 64) __builtin_prefetch(p + o);
+    __builtin_prefetch(p + sizeof t - 1);
+}
+inline void prefetch_varyings(const TriangleSetup& t, const float* vertices, const BinJob& job, int stride) {
+    for (int i = 0; i < 3; ++i) {
+        const std::uint32_t r = t.vtx[i];
+        const float* v = (r & kClippedVertexBit) ? &job.clip_pool[std::size_t(r & ~kClippedVertexBit) * stride]
+                                                 : &vertices[std::size_t(r) * stride];
+        __builtin_prefetch(v);
+        __builtin_prefetch(v + stride - 1);
+    }
+}
+
 // One lane's varyings and depth at screen barycentrics (b0, b1, b2): the
 // float operations of the block loop below, for one lane.
 template <int NV>
