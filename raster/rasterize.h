@@ -220,16 +220,30 @@ inline void load_block(const float* p, std::size_t row, bool full, std::uint32_t
 #endif
 }
 
-inline void store_block(float* p, std::size_t row, std::uint32_t mask, const float* v) {
+#if defined(__AVX2__)
+// Four values (one block row) into p where `mask` says: a plain store when it
+// says all four; when the row lies inside the buffer (`whole`), read, blend
+// and write back, since masked stores are slow on some CPUs (AMD's run them
+// as microcode); otherwise a masked store, which touches nothing outside.
+inline void store_row(float* p, __m128i mask, __m128 v, bool whole) {
+    if (_mm_movemask_ps(_mm_castsi128_ps(mask)) == 0xF) _mm_storeu_ps(p, v);
+    else if (whole) _mm_storeu_ps(p, _mm_blendv_ps(_mm_loadu_ps(p), v, _mm_castsi128_ps(mask)));
+    else _mm_maskstore_ps(p, mask, v);
+}
+#endif
+
+// `whole`: the block lies inside the buffer (block_inside()).
+inline void store_block(float* p, std::size_t row, std::uint32_t mask, const float* v, bool whole) {
 #if defined(__AVX2__)
     for (int h = 0; h < kBlockLanes; h += 8, p += 2 * row) {
         if (!((mask >> h) & 0xFFu)) continue;
         const __m256i mm = half_row_mask(mask >> h);
         const __m256 r = _mm256_permutevar8x32_ps(_mm256_loadu_ps(v + h), half_row_order());
-        _mm_maskstore_ps(p, _mm256_castsi256_si128(mm), _mm256_castps256_ps128(r));
-        _mm_maskstore_ps(p + row, _mm256_extracti128_si256(mm, 1), _mm256_extractf128_ps(r, 1));
+        store_row(p, _mm256_castsi256_si128(mm), _mm256_castps256_ps128(r), whole);
+        store_row(p + row, _mm256_extracti128_si256(mm, 1), _mm256_extractf128_ps(r, 1), whole);
     }
 #else
+    (void)whole;
     for (std::uint32_t m = mask; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         p[lane_offset_in(row, l)] = v[l];
@@ -237,14 +251,15 @@ inline void store_block(float* p, std::size_t row, std::uint32_t mask, const flo
 #endif
 }
 
+// Winners are tile-local: every block lies inside.
 inline void store_winner(std::uint32_t* p, std::size_t row, std::uint32_t mask, std::uint32_t id) {
 #if defined(__AVX2__)
-    const __m128i v = _mm_set1_epi32(int(id));
+    const __m128 v = _mm_castsi128_ps(_mm_set1_epi32(int(id)));
     for (int h = 0; h < kBlockLanes; h += 8, p += 2 * row) {
         if (!((mask >> h) & 0xFFu)) continue;
         const __m256i mm = half_row_mask(mask >> h);
-        _mm_maskstore_epi32(reinterpret_cast<int*>(p), _mm256_castsi256_si128(mm), v);
-        _mm_maskstore_epi32(reinterpret_cast<int*>(p + row), _mm256_extracti128_si256(mm, 1), v);
+        store_row(reinterpret_cast<float*>(p), _mm256_castsi256_si128(mm), v, true);
+        store_row(reinterpret_cast<float*>(p + row), _mm256_extracti128_si256(mm, 1), v, true);
     }
 #else
     for (std::uint32_t m = mask; m; m &= m - 1) p[lane_offset_in(row, __builtin_ctz(m))] = id;
@@ -330,11 +345,16 @@ inline int samples_of(const TileContext& c) { return MS ? c.sample_count() : 1; 
 // Depths of the covered samples and the LESS test against the target (every
 // covered sample passes without a depth test). `all_z`: also the depths of
 // samples nothing covers (for observers).
+// The 4x4 block at (bx, by) lies inside the target's planes.
+inline bool block_inside(const TileContext& c, int bx, int by) {
+    return c.target.local || (bx + kBlockSize <= c.width && by + kBlockSize <= c.height);
+}
+
 template <bool MS>
 inline void test_depth(const TriangleSetup& t, const TileContext& c, int bx, int by, bool depth_test, bool all_z,
                        BlockSamples& bs) {
     const TileTarget& tg = c.target;
-    const bool full = tg.local || (bx + kBlockSize <= c.width && by + kBlockSize <= c.height);
+    const bool full = block_inside(c, bx, by);
     const float* depth = tg.depth + tg.offset(bx, by);
     const int S = samples_of<MS>(c);
     bs.any_pass = 0;
@@ -471,7 +491,7 @@ void rasterize_depth(const TriangleSetup& t, TileContext& c, bool depth_test, bo
         std::uint32_t* win = tg.winner ? tg.winner + tg.winner_offset(bx, by) : nullptr;
         for (int s = 0; s < samples_of<MS>(c); ++s, depth += tg.plane) {
             if (!bs.pass[s]) continue;
-            if (depth_write) store_block(depth, tg.row, bs.pass[s], bs.z[s]);
+            if (depth_write) store_block(depth, tg.row, bs.pass[s], bs.z[s], block_inside(c, bx, by));
             if (winner != kNoWinner) store_winner(win + s * tg.wplane, tg.wrow, bs.pass[s], winner);
         }
         if (winner != kNoWinner) c.mark_dirty(bx, by);

@@ -154,8 +154,11 @@ void interpolate_block(const TriangleSetup& t, const TriangleVaryings<NV>& p, co
 }
 
 // Colour of the lanes in `mask` (one sample plane, `row` pixels wide) from
-// the program's output.
-inline void write_color(float* color, std::size_t row, std::uint32_t mask, const FragmentOut& out, Blend blend) {
+// the program's output. `whole`: the block lies inside the plane
+// (block_inside()), so a pair of pixels may be read, blended and written back
+// instead of a (slow) masked store.
+inline void write_color(float* color, std::size_t row, std::uint32_t mask, const FragmentOut& out, Blend blend,
+                        bool whole) {
     if (blend == Blend::Add) {
         for (std::uint32_t m = mask; m; m &= m - 1) {
             const int l = __builtin_ctz(m);
@@ -203,11 +206,14 @@ inline void write_color(float* color, std::size_t row, std::uint32_t mask, const
             } else if (two) {
                 const __m256i left = _mm256_setr_epi32(-1, -1, -1, -1, 0, 0, 0, 0);
                 const __m256i right = _mm256_setr_epi32(0, 0, 0, 0, -1, -1, -1, -1);
-                _mm256_maskstore_ps(c, two == 1u ? left : right, pairs[j]);
+                const __m256i pick = two == 1u ? left : right;
+                if (whole) _mm256_storeu_ps(c, _mm256_blendv_ps(_mm256_loadu_ps(c), pairs[j], _mm256_castsi256_ps(pick)));
+                else _mm256_maskstore_ps(c, pick, pairs[j]);
             }
         }
     }
 #else
+    (void)whole;
     if (mask == 0xFFFFu) {
         for (int l = 0; l < kBlockLanes; l += 2) {
             const float pair[8] = {out.r[l], out.g[l], out.b[l], out.a[l],
@@ -260,11 +266,12 @@ void shade_in_order(const Program& program, const DrawState& st, const TriangleS
 
     const TileTarget& tg = c.target;
     const std::size_t o = tg.offset(bx, by);
+    const bool inside = block_inside(c, bx, by);
     for (int s = 0; s < samples_of<MS>(c); ++s) {
         const std::uint32_t m = bs.pass[s] & live;
         if (!m) continue;
-        if (st.depth_write) store_block(tg.depth + o + s * tg.plane, tg.row, m, bs.z[s]);
-        if (tg.color) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, st.blend);
+        if (st.depth_write) store_block(tg.depth + o + s * tg.plane, tg.row, m, bs.z[s], inside);
+        if (tg.color) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, st.blend, inside);
         if (tg.winner) store_winner(tg.winner + tg.winner_offset(bx, by) + s * tg.wplane, tg.wrow, m, kNoWinner);
     }
 }
@@ -297,9 +304,10 @@ void shade_winner(const Program& program, const float* vertices, const BinJob& j
 
     const TileTarget& tg = c.target;
     const std::size_t o = tg.offset(bx, by);
+    const bool inside = block_inside(c, bx, by);
     for (int s = 0; s < samples_of<MS>(c); ++s) {
         const std::uint32_t m = won[s] & live;
-        if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, Blend::Replace);
+        if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, Blend::Replace, inside);
     }
 }
 
@@ -345,9 +353,10 @@ inline void write_block(TileContext& c, int bx, int by, std::uint32_t lanes, con
     const TileTarget& tg = c.target;
     if (!tg.color) return;
     const std::size_t o = tg.offset(bx, by);
+    const bool inside = block_inside(c, bx, by);
     for (int s = 0; s < samples_of<MS>(c); ++s) {
         const std::uint32_t m = write[s] & live;
-        if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, blend);
+        if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, blend, inside);
     }
 }
 
@@ -398,9 +407,10 @@ template <bool MS, class Program>
     if (!bs.any_pass) return;
     const TileTarget& tg = c.target;
     const std::size_t o = tg.offset(bx, by);
+    const bool inside = block_inside(c, bx, by);
     for (int s = 0; s < samples_of<MS>(c); ++s) {
         if (!bs.pass[s]) continue;
-        if (st.depth_write) store_block(tg.depth + o + s * tg.plane, tg.row, bs.pass[s], bs.z[s]);
+        if (st.depth_write) store_block(tg.depth + o + s * tg.plane, tg.row, bs.pass[s], bs.z[s], inside);
         if (tg.winner) store_winner(tg.winner + tg.winner_offset(bx, by) + s * tg.wplane, tg.wrow, bs.pass[s], kNoWinner);
     }
     const BlockSamples* centre = MS ? nullptr : &bs;
