@@ -126,8 +126,22 @@ void pack_lanes(const FragmentBlock<kPbrVaryings>* const* in, int count, const s
         for (int i = first[b]; i < first[b + 1]; ++i)
             for (int k = 0; k < kPbrVaryings; ++k) packed[k][i] = in[b]->var[k][lane[i]];
 #endif
+    if (n == N) return;
+#if defined(__AVX2__)
+    // Lanes n.. take lane n - 1's value, eight at a time.
+    const __m256i spare_from = _mm256_set1_epi32(n - 1);
+    for (int h = (n / 8) * 8; h < N; h += 8) {
+        const __m256 spare = _mm256_castsi256_ps(
+            _mm256_cmpgt_epi32(_mm256_add_epi32(_mm256_set1_epi32(h), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)), spare_from));
+        for (int k = 0; k < kPbrVaryings; ++k) {
+            const __m256 last = _mm256_broadcast_ss(&packed[k][n - 1]);
+            _mm256_storeu_ps(packed[k] + h, _mm256_blendv_ps(_mm256_loadu_ps(packed[k] + h), last, spare));
+        }
+    }
+#else
     for (int k = 0; k < kPbrVaryings; ++k)
         for (int i = n; i < N; ++i) packed[k][i] = packed[k][n - 1];
+#endif
 }
 
 } // namespace
