@@ -232,9 +232,9 @@ void PbrProgram::shade_packed(const FragmentBlock<kVaryings>* const* in, Fragmen
     const bool blend = material->m->alpha_mode == AlphaMode::Blend;
     for (int b = 0; b < count; ++b) {
         FragmentOut& o = *out[b];
-        const std::uint32_t m = in[b]->mask;
         const int nb = first[b + 1] - first[b];
 #if defined(__AVX2__) && defined(__BMI2__)
+        const std::uint32_t m = in[b]->mask;
         o.kill = _pdep_u32((kill >> first[b]) & ((1u << nb) - 1u), m);
         int next = first[b];
         for (int h = 0; h < kBlockLanes; h += 8) {
@@ -254,7 +254,7 @@ void PbrProgram::shade_packed(const FragmentBlock<kVaryings>* const* in, Fragmen
         std::fill(o.b, o.b + kBlockLanes, 0.0f);
         std::fill(o.a, o.a + kBlockLanes, 1.0f);
         o.kill = 0;
-        for (int i = first[b]; i < first[b] + nb; ++i) {
+        for (int i = first[b]; i < first[b] + nb && i < N; ++i) {  // (i < N always: for the compiler)
             const int l = lane[i];
             o.r[l] = rb.r[i]; o.g[l] = rb.g[i]; o.b[l] = rb.b[i]; o.a[l] = blend ? mb.alpha[i] : 1.0f;
             o.kill |= ((kill >> i) & 1u) << l;
