@@ -11,7 +11,8 @@
 //
 // Draws differ in program type: each is recorded as a DrawRecord whose
 // virtual entries are instantiated from the Program and Observer templates,
-// called once per (triangle, tile) or per (winner, block); the per-lane work
+// called once per (triangle, tile), per (winner, block), per run of a job's
+// triangles in a tile or per batch of winners' blocks; the per-lane work
 // inside stays inlined.
 #pragma once
 

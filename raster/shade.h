@@ -230,6 +230,18 @@ inline void write_color(float* color, std::size_t row, std::uint32_t mask, const
 #endif
 }
 
+// A block's fragment inputs: its lanes interpolated, its place, mask and triangle.
+template <bool MS, int NV>
+inline void fill_block(const TriangleSetup& t, const TriangleVaryings<NV>& pv, const TileContext& c, int bx, int by,
+                       std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in) {
+    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, lanes, centre, in);
+    in.x = bx;
+    in.y = by;
+    in.mask = lanes;
+    in.prim_id = t.prim_id;
+    in.front_facing = t.front_facing;
+}
+
 inline void count_quads(FrameStats& stats, std::uint32_t lanes) {
     for (int q = 0; q < 4; ++q) stats.quads_shaded += ((lanes >> (4 * q)) & 0xFu) != 0;
 }
@@ -248,12 +260,7 @@ void shade_in_order(const Program& program, const DrawState& st, const TriangleS
     if (!bs.any_pass) return;
 
     FragmentBlock<NV> in;
-    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, bs.any_pass, MS ? nullptr : &bs, in);
-    in.x = bx;
-    in.y = by;
-    in.mask = bs.any_pass;
-    in.prim_id = t.prim_id;
-    in.front_facing = t.front_facing;
+    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, MS ? nullptr : &bs, in);
     FragmentOut out;
     out.kill = 0;
     program.fragment(in, out);
@@ -286,12 +293,7 @@ void shade_winner(const Program& program, const float* vertices, const BinJob& j
     TriangleVaryings<NV> pv;
     prepare_varyings<NV>(t, vertices, job, pv);
     FragmentBlock<NV> in;
-    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, lanes, nullptr, in);
-    in.x = bx;
-    in.y = by;
-    in.mask = lanes;
-    in.prim_id = t.prim_id;
-    in.front_facing = t.front_facing;
+    fill_block<MS, NV>(t, pv, c, bx, by, lanes, nullptr, in);
     FragmentOut out;
     out.kill = 0;
     program.fragment(in, out);
@@ -378,18 +380,6 @@ template <bool MS, class Program>
                         in_order);
     batch.count = 0;
     batch.lanes = 0;
-}
-
-// A block's fragment inputs, as both callers above set them.
-template <bool MS, int NV>
-inline void fill_block(const TriangleSetup& t, const TriangleVaryings<NV>& pv, const TileContext& c, int bx, int by,
-                       std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in) {
-    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, lanes, centre, in);
-    in.x = bx;
-    in.y = by;
-    in.mask = lanes;
-    in.prim_id = t.prim_id;
-    in.front_facing = t.front_facing;
 }
 
 // shade_in_order() for a draw that never discards (DrawState::may_discard
