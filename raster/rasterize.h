@@ -342,14 +342,14 @@ struct BlockSamples {
 template <bool MS>
 inline int samples_of(const TileContext& c) { return MS ? c.sample_count() : 1; }
 
-// Depths of the covered samples and the LESS test against the target (every
-// covered sample passes without a depth test). `all_z`: also the depths of
-// samples nothing covers (for observers).
 // The 4x4 block at (bx, by) lies inside the target's planes.
 inline bool block_inside(const TileContext& c, int bx, int by) {
     return c.target.local || (bx + kBlockSize <= c.width && by + kBlockSize <= c.height);
 }
 
+// Depths of the covered samples and the LESS test against the target (every
+// covered sample passes without a depth test). `all_z`: also the depths of
+// samples nothing covers (for observers).
 template <bool MS>
 inline void test_depth(const TriangleSetup& t, const TileContext& c, int bx, int by, bool depth_test, bool all_z,
                        BlockSamples& bs) {
@@ -489,9 +489,10 @@ void rasterize_depth(const TriangleSetup& t, TileContext& c, bool depth_test, bo
         if (!bs.any_pass) return;
         float* depth = tg.depth + tg.offset(bx, by);
         std::uint32_t* win = tg.winner ? tg.winner + tg.winner_offset(bx, by) : nullptr;
+        const bool inside = block_inside(c, bx, by);
         for (int s = 0; s < samples_of<MS>(c); ++s, depth += tg.plane) {
             if (!bs.pass[s]) continue;
-            if (depth_write) store_block(depth, tg.row, bs.pass[s], bs.z[s], block_inside(c, bx, by));
+            if (depth_write) store_block(depth, tg.row, bs.pass[s], bs.z[s], inside);
             if (winner != kNoWinner) store_winner(win + s * tg.wplane, tg.wrow, bs.pass[s], winner);
         }
         if (winner != kNoWinner) c.mark_dirty(bx, by);

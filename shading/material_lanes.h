@@ -1,5 +1,5 @@
-// sample_material() for the lanes of a 4x4 block at once (all 16, or its live
-// lanes packed into 4 or 8): texture lookups through the block sampler
+// sample_material() for many lanes at once (a 4x4 block's 16 in place, or
+// the live lanes of one or several blocks packed into 4, 8 or 16): texture lookups through the block sampler
 // (sample_lanes.h), then the factors, clamps and normal mapping as loops over
 // lanes with selects instead of branches, which the compiler vectorises. Every
 // lane performs exactly the float operations of the scalar sample_material()

@@ -275,6 +275,12 @@ void PbrProgram::fragment_batch(const FragmentBlock<kVaryings>* const* in, Fragm
         for (int b = 0; b < count; ++b) fragment(*in[b], *out[b]);
         return;
     }
+    shade_packed_lanes(in, out, count);
+}
+
+// shade_packed() with the fewest lanes that hold the blocks' live ones.
+void PbrProgram::shade_packed_lanes(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out,
+                                    int count) const {
     int live = 0;
     for (int b = 0; b < count; ++b) live += __builtin_popcount(in[b]->mask);
     if (live > kBlockLanes) {  // more than one call's lanes: not a batch the rasterizer makes
@@ -297,7 +303,7 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
         } else {
             const FragmentBlock<kVaryings>* b = &in;
             FragmentOut* o = &out;
-            fragment_batch(&b, &o, 1);
+            shade_packed_lanes(&b, &o, 1);
         }
         return;
     }

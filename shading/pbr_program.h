@@ -62,6 +62,7 @@ struct PbrProgram {
 private:
     bool lit_lanes() const;
     void shade_block(const FragmentBlock<kVaryings>& in, FragmentOut& out) const;
+    void shade_packed_lanes(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out, int count) const;
     template <int N>
     void shade_packed(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out, int count) const;
 };

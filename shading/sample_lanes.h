@@ -15,8 +15,8 @@
 // lambda (Texture::lod), so textures with the same layout share one
 // preparation: a material whose maps have one size prepares once per block.
 // The loops run over the first N lanes (4, 8 or 16): the fragment program
-// packs the live lanes of a sparse block first, each lane remembering the
-// 2x2 quad whose lambda it uses.
+// packs the live lanes of one or several sparse blocks first, each lane
+// remembering the 2x2 quad (of up to kMaxQuadSlots) whose lambda it uses.
 #pragma once
 
 #include <cstdint>
