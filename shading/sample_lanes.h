@@ -216,6 +216,21 @@ inline typename V::I gather_texels(const std::uint8_t* base, typename V::I idx) 
     return V::template gather_i<1>(base, V::add_i(idx, V::add_i(idx, idx)));  // 3 idx
 }
 
+// The packed bytes of texels idx and idx + 1 (C bytes each) for W lanes: one
+// 4-byte read per lane holds both when C <= 2, one 8-byte read when C >= 3.
+// Texture keeps 8 spare bytes after the chain (Texture::kReadSlack).
+template <class V, int C>
+inline void gather_texel_pairs(const std::uint8_t* base, typename V::I idx, typename V::I& left, typename V::I& right) {
+    if constexpr (C <= 2) {
+        left = V::template gather_i<C>(base, idx);
+        right = V::srlv_i(left, V::set1_i(8 * C));
+    } else if constexpr (C == 3) {
+        V::template gather_q<1, 24>(base, V::add_i(idx, V::add_i(idx, idx)), left, right);
+    } else {
+        V::template gather_q<4, 32>(base, idx, left, right);
+    }
+}
+
 // Stored channel c of the words as floats, through its table.
 template <class V>
 inline typename V::F decode_channel(typename V::I words, int c, const float* table, bool divide) {
@@ -229,11 +244,23 @@ template <class V, int C>
 [[gnu::always_inline]] inline void bilinear_unorm8(const Texture& tex, const bool* divide, unsigned need, const std::int32_t (*idx)[kMaxN],
                             const float* tx_lanes, const float* ty_lanes, int l0, typename V::F* result) {
     using F = typename V::F;
+    using I = typename V::I;
     const std::uint8_t* base = tex.unorm8_data();
-    const typename V::I wa = gather_texels<V, C>(base, V::load_i(idx[0] + l0));
-    const typename V::I wb = gather_texels<V, C>(base, V::load_i(idx[1] + l0));
-    const typename V::I wc = gather_texels<V, C>(base, V::load_i(idx[2] + l0));
-    const typename V::I wd = gather_texels<V, C>(base, V::load_i(idx[3] + l0));
+    const I ia = V::load_i(idx[0] + l0), ib = V::load_i(idx[1] + l0);
+    const I ic = V::load_i(idx[2] + l0), id = V::load_i(idx[3] + l0);
+    // Unless a lane's footprint wraps or clamps at a row's end, its right taps
+    // follow its left ones in memory: half the gathered elements.
+    const I one = V::set1_i(1);
+    I wa, wb, wc, wd;
+    if (V::all_i(V::and_i(V::cmpeq_i(ib, V::add_i(ia, one)), V::cmpeq_i(id, V::add_i(ic, one))))) {
+        gather_texel_pairs<V, C>(base, ia, wa, wb);
+        gather_texel_pairs<V, C>(base, ic, wc, wd);
+    } else {
+        wa = gather_texels<V, C>(base, ia);
+        wb = gather_texels<V, C>(base, ib);
+        wc = gather_texels<V, C>(base, ic);
+        wd = gather_texels<V, C>(base, id);
+    }
     const F tx = V::load_f(tx_lanes + l0), ty = V::load_f(ty_lanes + l0);
     for (int c = 0; c < C; ++c) {
         if (!((need >> c) & 1u)) continue;

@@ -29,6 +29,17 @@ template <> struct Simd<8> {
         return _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale);
     }
     static F gather_f(const float* table, I idx) { return _mm256_i32gather_ps(table, idx, 4); }
+    // The 8 bytes at base + Scale idx for each lane: their low 4 bytes, and 4
+    // bytes from Shift bits on. The gathers take the lanes in the order
+    // 0 1 4 5 and 2 3 6 7, so that one in-lane shuffle puts them back.
+    template <int Scale, int Shift> static void gather_q(const std::uint8_t* base, I idx, I& low, I& shifted) {
+        const I order = _mm256_permutevar8x32_epi32(idx, _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7));
+        const auto* q = reinterpret_cast<const long long*>(base);
+        const I a = _mm256_i32gather_epi64(q, _mm256_castsi256_si128(order), Scale);
+        const I b = _mm256_i32gather_epi64(q, _mm256_extracti128_si256(order, 1), Scale);
+        low = pick_low(a, b);
+        shifted = pick_low(_mm256_srli_epi64(a, Shift), _mm256_srli_epi64(b, Shift));
+    }
     static I add_i(I a, I b) { return _mm256_add_epi32(a, b); }
     static I and_i(I a, I b) { return _mm256_and_si256(a, b); }
     static I srlv_i(I a, I n) { return _mm256_srlv_epi32(a, n); }
@@ -45,6 +56,13 @@ template <> struct Simd<8> {
     static F cmpge(F a, F b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }
     static F cmplt(F a, F b) { return _mm256_cmp_ps(a, b, _CMP_LT_OQ); }
     static bool all(F mask) { return _mm256_movemask_ps(mask) == 0xFF; }
+    static bool all_i(I mask) { return _mm256_movemask_epi8(mask) == -1; }
+
+private:
+    // The low dwords of a's and b's qwords: a0 a1 b0 b1 | a2 a3 b2 b3.
+    static I pick_low(I a, I b) {
+        return _mm256_castps_si256(_mm256_shuffle_ps(_mm256_castsi256_ps(a), _mm256_castsi256_ps(b), _MM_SHUFFLE(2, 0, 2, 0)));
+    }
 };
 
 template <> struct Simd<4> {
@@ -61,6 +79,12 @@ template <> struct Simd<4> {
         return _mm_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale);
     }
     static F gather_f(const float* table, I idx) { return _mm_i32gather_ps(table, idx, 4); }
+    // As Simd<8>::gather_q, for 4 lanes.
+    template <int Scale, int Shift> static void gather_q(const std::uint8_t* base, I idx, I& low, I& shifted) {
+        const __m256i q = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(base), idx, Scale);
+        low = pick_low(q);
+        shifted = pick_low(_mm256_srli_epi64(q, Shift));
+    }
     static I add_i(I a, I b) { return _mm_add_epi32(a, b); }
     static I and_i(I a, I b) { return _mm_and_si128(a, b); }
     static I srlv_i(I a, I n) { return _mm_srlv_epi32(a, n); }
@@ -77,6 +101,15 @@ template <> struct Simd<4> {
     static F cmpge(F a, F b) { return _mm_cmp_ps(a, b, _CMP_GE_OQ); }
     static F cmplt(F a, F b) { return _mm_cmp_ps(a, b, _CMP_LT_OQ); }
     static bool all(F mask) { return _mm_movemask_ps(mask) == 0xF; }
+    static bool all_i(I mask) { return _mm_movemask_epi8(mask) == 0xFFFF; }
+
+private:
+    // The low dwords of q's four qwords.
+    static I pick_low(__m256i q) {
+        const __m128 lo = _mm_castsi128_ps(_mm256_castsi256_si128(q));
+        const __m128 hi = _mm_castsi128_ps(_mm256_extracti128_si256(q, 1));
+        return _mm_castps_si128(_mm_shuffle_ps(lo, hi, _MM_SHUFFLE(2, 0, 2, 0)));
+    }
 };
 
 } // namespace prast

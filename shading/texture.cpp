@@ -360,11 +360,11 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const flo
     }
     tex.layout(w, h);
     const std::size_t C = std::size_t(channels);
-    // 3 spare bytes: the block sampler reads 4 bytes at any texel.
-    const std::size_t bytes = tex.total_texels_ * C + 3;
+    // Spare bytes: the block sampler reads 4 or 8 bytes at any texel.
+    const std::size_t bytes = tex.total_texels_ * C + kReadSlack;
     tex.bytes_.reset(allocate_texels(bytes));
     std::uint8_t* base = tex.bytes_.get();
-    std::memset(base + tex.total_texels_ * C, 0, 3);
+    std::memset(base + tex.total_texels_ * C, 0, kReadSlack);
     if (level0) std::memcpy(base, level0, std::size_t(w) * std::size_t(h) * C);
     for (int l = 1; l < tex.level_count_; ++l) {
         const Level& a = tex.levels_[l - 1];

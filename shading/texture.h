@@ -81,11 +81,12 @@ public:
     glm::vec4 texel_at(std::size_t i) const;
 
     // Storage. Float: texel_data() holds float RGBA. 8-bit: unorm8_data() holds
-    // channels() bytes per texel (and 3 more bytes, so that 4 bytes can be read
-    // at any texel); stored channel c becomes a float through table(c), and
+    // channels() bytes per texel (and kReadSlack more bytes, so that 8 bytes can
+    // be read at any texel); stored channel c becomes a float through table(c), and
     // output component k (r, g, b, a) is stored channel swizzle(k), or 1 when
     // swizzle(k) == kOne.
     static constexpr int kOne = 4;
+    static constexpr std::size_t kReadSlack = 8;
     bool is_unorm8() const { return channels_ > 0; }
     int channels() const { return channels_; }
     int swizzle(int k) const { return swizzle_[k]; }

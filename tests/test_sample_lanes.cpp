@@ -388,9 +388,61 @@ void check_batch(std::uint32_t seed) {
     }
 }
 
+#ifdef __AVX2__
+// gather_texel_pairs() against the bytes: for W lanes of a C-channel texture,
+// texel i's bytes and texel i + 1's, up to the chain's last texel (whose
+// "next" lies in the spare bytes).
+template <int W, int C>
+void check_texel_pairs(std::mt19937& rng) {
+    using V = Simd<W>;
+    Image img;
+    img.width = 37;
+    img.height = 5;
+    img.channels = C;
+    img.pixels.resize(img.texel_count() * C);
+    std::uniform_int_distribution<int> byte(0, 255);
+    for (std::uint8_t& c : img.pixels) c = std::uint8_t(byte(rng));
+    const Texture tex = Texture::from_image(std::move(img), Wrap::Repeat, Wrap::Repeat);
+    const std::int32_t texels = std::int32_t(tex.level_offset(tex.levels() - 1)) + 1;
+    const std::uint8_t* base = tex.unorm8_data();
+    std::uniform_int_distribution<std::int32_t> any(0, texels - 1);
+    for (int iter = 0; iter < 200; ++iter) {
+        alignas(32) std::int32_t idx[W];
+        for (int l = 0; l < W; ++l) idx[l] = iter % 4 == 0 && l == iter % W ? texels - 1 : any(rng);
+        typename V::I left, right;
+        sample_lanes_detail::gather_texel_pairs<V, C>(base, V::load_i(idx), left, right);
+        alignas(32) std::uint32_t got_left[W], got_right[W];
+        std::memcpy(got_left, &left, sizeof got_left);
+        std::memcpy(got_right, &right, sizeof got_right);
+        for (int l = 0; l < W; ++l) {
+            for (int c = 0; c < C; ++c) {
+                INFO("W ", W, " C ", C, " lane ", l, " texel ", idx[l], " channel ", c);
+                CHECK(((got_left[l] >> (8 * c)) & 0xFFu) == base[std::size_t(idx[l]) * C + c]);
+                if (idx[l] + 1 < texels)
+                    CHECK(((got_right[l] >> (8 * c)) & 0xFFu) == base[std::size_t(idx[l] + 1) * C + c]);
+            }
+        }
+    }
+}
+#endif
+
 } // namespace
 
 TEST_SUITE("sample_lanes") {
+#ifdef __AVX2__
+TEST_CASE("texel pairs gathered in one read per lane equal the texels' bytes") {
+    std::mt19937 rng(11);
+    check_texel_pairs<8, 1>(rng);
+    check_texel_pairs<8, 2>(rng);
+    check_texel_pairs<8, 3>(rng);
+    check_texel_pairs<8, 4>(rng);
+    check_texel_pairs<4, 1>(rng);
+    check_texel_pairs<4, 2>(rng);
+    check_texel_pairs<4, 3>(rng);
+    check_texel_pairs<4, 4>(rng);
+}
+#endif
+
 TEST_CASE("block trilinear sampling equals Texture::sample_trilinear bit for bit") {
     for (std::uint32_t seed = 1; seed <= 3000; ++seed) {
         check_sampler<16>(seed);
