@@ -35,6 +35,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -50,6 +51,7 @@
 #include "scene/encode_png.h"
 #include "scene/image.h"
 #include "scene/load_scene.h"
+#include "shading/resolve.h"
 #include "shading/scene_renderer.h"
 #include "shading/tonemap.h"
 
@@ -461,9 +463,10 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
     fs.shadows.size = shadow_size;
     Framebuffer fb(width, height);
     // The frame writes the 8-bit image in its tile pass (tone map, sRGB), as render does.
-    std::vector<std::uint8_t> rgba8(std::size_t(width) * std::size_t(height) * 4);
+    Rgba8Buffer image(std::size_t(width) * std::size_t(height));
+    const std::uint8_t* rgba8 = image.data();
     ImageOutput out8;
-    out8.rgba8 = rgba8.data();
+    out8.rgba8 = image.data();
     out8.tonemap = ToneMap::Aces;
     std::vector<double> frame, vertex, setup, raster;
     for (int i = 0; i <= repeat; ++i) {  // frame 0 warms up and keeps the framebuffer (coverage below)
@@ -509,8 +512,9 @@ void measure_alternating(const Workload& w, const std::vector<int>& threads, int
     std::vector<std::unique_ptr<Renderer>> renderers;
     std::vector<std::unique_ptr<SceneRenderer>> srs;
     std::vector<Framebuffer> fbs;
-    std::vector<std::vector<std::uint8_t>> images(n, std::vector<std::uint8_t>(std::size_t(width) * std::size_t(height) * 4));
+    std::vector<Rgba8Buffer> images;
     for (std::size_t i = 0; i < n; ++i) {
+        images.emplace_back(std::size_t(width) * std::size_t(height));
         renderers.push_back(std::make_unique<Renderer>(RendererOptions{threads[i], tile}));
         srs.push_back(std::make_unique<SceneRenderer>(*scene, *renderers.back()));
         fbs.emplace_back(width, height);
@@ -543,7 +547,8 @@ void measure_alternating(const Workload& w, const std::vector<int>& threads, int
         const Summary f = summarise(ms[i]), r = summarise(ratio[i]);
         const double pass_ms = summarise(pass[i]).median, cpu_ms = summarise(cpu[i]).median,
                      idle_ms = summarise(idle[i]).median;
-        const bool same = images[i] == images[0];
+        const std::size_t bytes = std::size_t(width) * std::size_t(height) * 4;
+        const bool same = std::memcmp(images[i].data(), images[0].data(), bytes) == 0;
         char b[512];
         if (json) {
             std::snprintf(b, sizeof b,

@@ -42,6 +42,7 @@
 #include "scene/write_image.h"
 #include "shading/environment.h"
 #include "shading/memory_plan.h"
+#include "shading/resolve.h"
 #include "shading/scene_renderer.h"
 #include "shading/surface.h"
 #include "shading/tonemap.h"
@@ -311,13 +312,13 @@ void print_pixel_ibl(SceneRenderer& sr, const FrameSettings& settings, const Mes
                 double(ref.b));
 }
 
-void print_pixel(const Scene& scene, const Camera& cam, const Framebuffer& fb, const std::vector<std::uint8_t>& rgba8,
+void print_pixel(const Scene& scene, const Camera& cam, const Framebuffer& fb, const std::uint8_t* rgba8,
                  glm::ivec2 px, int frame, SceneRenderer& sr, const FrameSettings& settings, int ibl_samples) {
     const float* c = fb.pixel(px.x, px.y);
     const float depth = fb.depth[std::size_t(px.y) * std::size_t(fb.width) + std::size_t(px.x)];
     std::printf("pixel %d,%d frame %d: depth %.6f linear %.6g %.6g %.6g", px.x, px.y, frame, double(depth),
                 double(c[0]), double(c[1]), double(c[2]));
-    if (!rgba8.empty()) {
+    if (rgba8) {
         const std::uint8_t* s = &rgba8[(std::size_t(px.y) * std::size_t(fb.width) + std::size_t(px.x)) * 4];
         std::printf(" srgb8 %d %d %d", s[0], s[1], s[2]);
     }
@@ -490,10 +491,12 @@ int run(int argc, char** argv) {
     }
 
     Framebuffer fb(opt.width, opt.height);
-    std::vector<std::uint8_t> rgba8(opt.hdr_output() ? 0 : std::size_t(opt.width) * opt.height * 4);
-    // The PNG's bytes come out of the frame's tile pass (resolve.h).
+    // The PNG's bytes come out of the frame's tile pass (resolve.h), which
+    // streams whole cache lines (stream_fill.h) when the rows start on one.
+    Rgba8Buffer rgba8_store(opt.hdr_output() ? 0 : std::size_t(opt.width) * std::size_t(opt.height));
+    std::uint8_t* rgba8 = rgba8_store.data();
     ImageOutput out8;
-    out8.rgba8 = rgba8.data();
+    out8.rgba8 = rgba8;
     out8.exposure = opt.exposure;
     out8.tonemap = opt.effective_tonemap();
     out8.raw = debug_view_is_data(opt.view);
@@ -522,7 +525,7 @@ int run(int argc, char** argv) {
         g_stage = "writing " + path;
         try {
             if (opt.hdr_output()) write_hdr_atomic(path, fb.width, fb.height, fb.color.data());
-            else write_png_atomic(path, fb.width, fb.height, rgba8.data());
+            else write_png_atomic(path, fb.width, fb.height, rgba8);
         } catch (const WriteError& e) {
             return fail(kExitBadFile, e.what());
         }

@@ -28,20 +28,36 @@ struct StreamPattern {
     }
 };
 
+// The 4 pattern bytes at offset i from the fill's start (i a multiple of 4).
+inline int pattern_word(const StreamPattern& p, std::size_t i) {
+    int w;
+    std::memcpy(&w, p.rep + i % p.size, sizeof w);
+    return w;
+}
+
 // Writes `bytes` bytes at dst, the pattern repeated from dst on. Call
 // stream_fence() before other threads read the memory.
 inline void stream_fill(void* dst, std::size_t bytes, const StreamPattern& p) {
     if (bytes == 0) return;  // dst may then be null (memcpy's arguments may not)
     auto* out = static_cast<unsigned char*>(dst);
 #if defined(__AVX2__)
-    // Plain bytes up to a 32-byte boundary, whole 32-byte stores, plain bytes after.
-    std::size_t head = (32 - (reinterpret_cast<std::uintptr_t>(out) & 31)) & 31;
+    // Up to a 32-byte boundary, whole 32-byte stores, the rest: all streamed,
+    // 4 bytes at a time at the ends. A plain store into a line that streamed
+    // stores also write reads the line first and waits for it: with a 16-byte
+    // head and tail per row such stores took 15% of the bottle's tile pass.
+    const std::uintptr_t at = reinterpret_cast<std::uintptr_t>(out);
+    if ((at | bytes) & 3) {  // not in 4-byte units: plain stores
+        for (std::size_t i = 0; i < bytes; i += 32)
+            std::memcpy(out + i, p.rep, bytes - i < 32 ? bytes - i : 32);
+        return;
+    }
+    std::size_t head = (32 - (at & 31)) & 31;
     if (head > bytes) head = bytes;
-    std::memcpy(out, p.rep, head);
+    std::size_t i = 0;
+    for (; i < head; i += 4) _mm_stream_si32(reinterpret_cast<int*>(out + i), pattern_word(p, i));
     const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p.rep + head % p.size));
-    std::size_t i = head;
     for (; i + 32 <= bytes; i += 32) _mm256_stream_si256(reinterpret_cast<__m256i*>(out + i), v);
-    std::memcpy(out + i, p.rep + i % p.size, bytes - i);
+    for (; i < bytes; i += 4) _mm_stream_si32(reinterpret_cast<int*>(out + i), pattern_word(p, i));
 #else
     for (std::size_t i = 0; i < bytes; i += 32)
         std::memcpy(out + i, p.rep, bytes - i < 32 ? bytes - i : 32);

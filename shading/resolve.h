@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 #include "raster/frame.h"
 #include "raster/stream_fill.h"
@@ -21,6 +22,30 @@ void resolve_pixels_srgb8(const float* rgba, std::size_t count, float exposure, 
 
 // Data (debug views) as is: clamp to [0, 1], * 255, round; alpha 255.
 void resolve_pixels_raw8(const float* rgba, std::size_t count, std::uint8_t* out);
+
+// Memory for an 8-bit RGBA image of `pixels` pixels whose first byte starts a
+// cache line: then, when the width is a multiple of 16 pixels, TileResolve
+// streams whole lines (a partly streamed line is flushed in pieces).
+class Rgba8Buffer {
+public:
+    explicit Rgba8Buffer(std::size_t pixels) : store_(pixels ? pixels * 4 + 63 : 0) {
+        if (pixels) {
+            const std::uintptr_t at = reinterpret_cast<std::uintptr_t>(store_.data());
+            data_ = store_.data() + ((64 - (at & 63)) & 63);
+        }
+    }
+    Rgba8Buffer(const Rgba8Buffer&) = delete;  // data_ points into store_
+    Rgba8Buffer& operator=(const Rgba8Buffer&) = delete;
+    Rgba8Buffer(Rgba8Buffer&&) = default;      // the vector's memory moves along
+    Rgba8Buffer& operator=(Rgba8Buffer&&) = default;
+
+    std::uint8_t* data() { return data_; }  // null for 0 pixels
+    const std::uint8_t* data() const { return data_; }
+
+private:
+    std::vector<std::uint8_t> store_;
+    std::uint8_t* data_ = nullptr;
+};
 
 // A frame's tile hook writing the 8-bit image (rows of `width` pixels) from
 // each finished tile.

@@ -540,7 +540,8 @@ TEST_CASE("frame: tiles no draw reaches hold the resolved clear value and are ha
 
 TEST_CASE("stream_fill: the bytes of a plain fill at any alignment and length, and nothing around them") {
     // The fill of untouched tiles and their 8-bit output: non-temporal 32-byte
-    // stores in the middle, plain bytes at both ends.
+    // stores in the middle, 4-byte ones at both ends; plain stores for an
+    // address or a length not in 4-byte units.
     const unsigned char pattern[16] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
     int wrong = 0, cases = 0;
     for (std::size_t size : {std::size_t(4), std::size_t(16)})
