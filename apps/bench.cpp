@@ -461,7 +461,7 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
     FrameSettings fs = lw.settings;
     fs.shadows.enabled = shadows;
     fs.shadows.size = shadow_size;
-    Framebuffer fb(width, height);
+    Framebuffer fb = Framebuffer::deferred(width, height);  // as render: allocated by the first (kept) frame
     // The frame writes the 8-bit image in its tile pass (tone map, sRGB), as render does.
     Rgba8Buffer image(std::size_t(width) * std::size_t(height));
     const std::uint8_t* rgba8 = image.data();
@@ -517,7 +517,7 @@ void measure_alternating(const Workload& w, const std::vector<int>& threads, int
         images.emplace_back(std::size_t(width) * std::size_t(height));
         renderers.push_back(std::make_unique<Renderer>(RendererOptions{threads[i], tile}));
         srs.push_back(std::make_unique<SceneRenderer>(*scene, *renderers.back()));
-        fbs.emplace_back(width, height);
+        fbs.push_back(Framebuffer::deferred(width, height));  // transient frames only: never allocated
     }
     std::vector<std::vector<double>> ms(n), ratio(n), pass(n), cpu(n), idle(n);
     for (int k = 0; k <= repeat; ++k) {  // round 0 warms up

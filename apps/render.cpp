@@ -490,7 +490,8 @@ int run(int argc, char** argv) {
         }
     }
 
-    Framebuffer fb(opt.width, opt.height);
+    // Allocated only if a frame keeps its pixels (--pixel, .hdr, the overlay views).
+    Framebuffer fb = Framebuffer::deferred(opt.width, opt.height);
     // The PNG's bytes come out of the frame's tile pass (resolve.h), which
     // streams whole cache lines (stream_fill.h) when the rows start on one.
     Rgba8Buffer rgba8_store(opt.hdr_output() ? 0 : std::size_t(opt.width) * std::size_t(opt.height));

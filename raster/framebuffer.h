@@ -1,6 +1,8 @@
 // The render target: linear float RGBA colour and float depth, row-major, row 0
 // at the top. Depth is 32-bit float window z in [0, 1], cleared to 1, test LESS.
 // A depth target (shadow maps) has no colour: depth_only(w, h), color empty.
+// A deferred target (deferred(w, h)) has a size and no storage until a frame
+// keeps its pixels.
 // A multisampled frame keeps its samples in tile-local buffers and leaves here
 // the resolved colour and each pixel's nearest sample depth (README "Anti-aliasing").
 #pragma once
@@ -27,7 +29,26 @@ struct Framebuffer {
         return fb;
     }
 
-    bool has_color() const { return !color.empty(); }
+    // A colour target of w x h pixels that holds no storage yet: the first
+    // frame that keeps its pixels (Renderer::begin of a frame that is not
+    // transient, or Renderer::clear) allocates it as resize() does. A
+    // transient frame never reads or writes the framebuffer, so a caller that
+    // only wants the 8-bit image skips 20 bytes a pixel of allocation and
+    // fill (41 MB at 1920x1080). Until then color and depth are empty: a
+    // size without depth storage is what marks it.
+    static Framebuffer deferred(int w, int h) {
+        Framebuffer fb;
+        fb.width = w;
+        fb.height = h;
+        return fb;
+    }
+    bool is_deferred() const { return width > 0 && height > 0 && depth.empty(); }
+    // Allocates a deferred framebuffer's storage; nothing otherwise.
+    void allocate() {
+        if (is_deferred()) resize(width, height);
+    }
+
+    bool has_color() const { return !color.empty() || is_deferred(); }
 
     void resize(int w, int h) {
         width = w;

@@ -52,6 +52,7 @@ Renderer::Renderer(const RendererOptions& options)
 Renderer::~Renderer() = default;
 
 void Renderer::clear(Framebuffer& fb, float r, float g, float b, float a, float z) {
+    fb.allocate();
     constexpr int kRows = 32;
     const int chunks = (fb.height + kRows - 1) / kRows;
     pool_.run(chunks, [&](int chunk, int) {
@@ -76,6 +77,7 @@ void Renderer::begin(Framebuffer& fb, const FrameOptions& options) {
     fb_ = &fb;
     options_ = options;
     options_.transient = options.transient && options.clear;  // a frame that loads the target keeps it
+    if (!options_.transient) fb.allocate();  // a deferred framebuffer's first kept frame
     grid_ = TileGrid(fb.width, fb.height, tile_size_);
     draws_.clear();
 }

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
+#include <exception>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -75,7 +77,12 @@ void encode_band(const std::uint8_t* pixels, int width, int channels, int y0, in
         band.error = "deflateInit2 failed";
         return;
     }
-    band.deflated.resize(deflateBound(&z, uLong(filtered.size())) + 16);
+    try {
+        band.deflated.resize(deflateBound(&z, uLong(filtered.size())) + 16);
+    } catch (...) {
+        deflateEnd(&z);
+        throw;
+    }
     z.next_in = filtered.data();
     z.avail_in = uInt(filtered.size());
     z.next_out = band.deflated.data();
@@ -95,18 +102,29 @@ PngOptions png_options_threads(int threads) {
     if (threads == 1) return o;
     o.parallel_for = [threads](int count, const std::function<void(int)>& fn) {
         std::atomic<int> next{0};
+        std::mutex failed_lock;
+        std::exception_ptr failed;  // the first band that threw (out of memory): rethrown here
         auto work = [&] {
-            for (int b = next++; b < count; b = next++) fn(b);
+            try {
+                for (int b = next++; b < count; b = next++) fn(b);
+            } catch (...) {
+                next = count;  // the others stop too
+                const std::lock_guard<std::mutex> lock(failed_lock);
+                if (!failed) failed = std::current_exception();
+            }
         };
         std::vector<std::thread> pool;
-        // A thread that cannot be started (a process limit) leaves the work
-        // to the others; unwinding past joinable threads would terminate.
+        // A thread that cannot be started (a process limit, no memory for its
+        // stack or for the vector) leaves the work to the others; unwinding
+        // past joinable threads would terminate the process.
         try {
+            pool.reserve(std::size_t(std::min(threads, count)));
             for (int t = 1; t < std::min(threads, count); ++t) pool.emplace_back(work);
-        } catch (const std::system_error&) {
+        } catch (...) {
         }
         work();
         for (std::thread& t : pool) t.join();
+        if (failed) std::rethrow_exception(failed);
     };
     return o;
 }

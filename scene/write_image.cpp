@@ -108,7 +108,7 @@ void write_png_atomic(const std::string& path, int width, int height, const std:
     try {
         bytes = encode_png(width, height, rgba8);
     } catch (const std::bad_alloc&) {
-        throw WriteError(path + ": PNG encoding failed (out of memory)");
+        throw WriteError(path + ": PNG encoding failed: out of memory");
     } catch (const WriteError& e) {
         throw WriteError(path + ": " + e.what());
     }

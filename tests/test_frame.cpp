@@ -613,6 +613,54 @@ TEST_CASE("frame: a transient frame hands the hook the same colours and leaves t
             }
 }
 
+TEST_CASE("frame: a deferred framebuffer stays empty through transient frames and fills on the first kept one") {
+    // Framebuffer::deferred: what render and bench use. Transient frames at 1
+    // and 4 samples hand the hook the colours of a frame into an allocated
+    // framebuffer and allocate nothing; the first kept frame allocates it and
+    // leaves the same pixels as a framebuffer allocated from the start.
+    const OverdrawScene sc(150, 97, 5, true);
+    for (int samples : {1, 4}) {
+        CAPTURE(samples);
+        const FrameOptions base = frame_options(FrameOptions::Visibility::Auto, samples);
+        Renderer r({2, 32});
+        Framebuffer full(sc.W, sc.H);
+        HookCapture want(sc.W, sc.H);
+        r.begin(full, base);
+        sc.submit(r);
+        r.end(want);
+
+        Framebuffer fb = Framebuffer::deferred(sc.W, sc.H);
+        CHECK(fb.is_deferred());
+        CHECK(fb.has_color());
+        for (int frame = 0; frame < 2; ++frame) {
+            FrameOptions o = base;
+            o.transient = true;
+            HookCapture got(sc.W, sc.H);
+            r.begin(fb, o);
+            sc.submit(r);
+            r.end(got);
+            CHECK(got.not_once() == 0);
+            CHECK(std::memcmp(got.seen.data(), want.seen.data(), want.seen.size() * sizeof(float)) == 0);
+            CHECK(fb.color.empty());
+            CHECK(fb.depth.empty());
+        }
+        HookCapture kept(sc.W, sc.H);
+        r.begin(fb, base);
+        sc.submit(r);
+        r.end(kept);
+        CHECK_FALSE(fb.is_deferred());
+        CHECK(fb.color == full.color);
+        CHECK(fb.depth == full.depth);
+        CHECK(std::memcmp(kept.seen.data(), want.seen.data(), want.seen.size() * sizeof(float)) == 0);
+    }
+    Framebuffer cleared = Framebuffer::deferred(5, 3);  // Renderer::clear allocates too
+    Renderer r({1, 16});
+    r.clear(cleared, 0.25f, 0.5f, 0.75f, 1.0f, 0.5f);
+    CHECK(cleared.color.size() == 5 * 3 * 4);
+    CHECK(cleared.color[6] == 0.75f);
+    CHECK(cleared.depth[14] == 0.5f);
+}
+
 TEST_CASE("frame: a renderer's transient frames show each frame's own clear colour") {
     // The tile of the clear colour that empty transient tiles hand over is
     // kept between frames: a new colour, sample count or tile must refill it.
