@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <new>
 
 #include <fcntl.h>
@@ -84,14 +85,15 @@ void write_file_atomic(const std::string& path, const std::vector<std::uint8_t>&
 } // namespace
 
 std::vector<std::uint8_t> encode_png(int width, int height, const std::uint8_t* rgba8) {
-    std::vector<std::uint8_t> rgb(std::size_t(width) * height * 3);
+    // Every byte is written below: no zero fill first.
+    const std::unique_ptr<std::uint8_t[]> rgb(new std::uint8_t[std::size_t(width) * height * 3]);
     for (std::size_t i = 0, n = std::size_t(width) * height; i < n; ++i) {
         rgb[i * 3] = rgba8[i * 4];
         rgb[i * 3 + 1] = rgba8[i * 4 + 1];
         rgb[i * 3 + 2] = rgba8[i * 4 + 2];
     }
     try {
-        return encode_png_pixels(rgb.data(), width, height, 3, png_options_threads());
+        return encode_png_pixels(rgb.get(), width, height, 3, png_options_threads());
     } catch (const std::bad_alloc&) {
         throw WriteError("PNG encoding failed: out of memory");
     } catch (const std::exception& e) {
