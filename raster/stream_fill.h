@@ -44,7 +44,7 @@ inline void stream_fill(void* dst, std::size_t bytes, const StreamPattern& p) {
     // Up to a 32-byte boundary, whole 32-byte stores, the rest: all streamed,
     // 4 bytes at a time at the ends. A plain store into a line that streamed
     // stores also write reads the line first and waits for it: with a 16-byte
-    // head and tail per row such stores took 15% of the bottle's tile pass.
+    // head and tail per row such stores took a third of the bottle's tile pass.
     const std::uintptr_t at = reinterpret_cast<std::uintptr_t>(out);
     if ((at | bytes) & 3) {  // not in 4-byte units: plain stores
         for (std::size_t i = 0; i < bytes; i += 32)
