@@ -339,6 +339,9 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     sc.refs.clear();
     for (const std::unique_ptr<detail::DrawRecord>& dp : draws_) {
         detail::DrawRecord& d = *dp;
+        // Shaded here, triangle by triangle (not depth only, not left to the
+        // visibility pass's winners).
+        const bool in_order = d.mode == detail::DrawMode::InOrder || (d.mode == detail::DrawMode::Visible && !defer);
         bool flushed = false;
         for (int j = d.first_job; j < d.first_job + d.job_count; ++j) {
             const BinJob& job = jobs_[std::size_t(j)];
@@ -351,13 +354,13 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
                 pending = false;
                 flushed = true;
             }
-            if (d.batches && (d.mode == detail::DrawMode::InOrder || (d.mode == detail::DrawMode::Visible && !defer))) {
+            if (d.batches && in_order) {
                 d.rasterize_in_order_batched(job, begin, end, c);
                 continue;
             }
             for (std::uint32_t i = begin; i < end; ++i) {
                 if (i + 2 < end) detail::prefetch_setup(job.setups[job.items[i + 2]]);
-                if (i + 1 < end && !(d.mode == detail::DrawMode::Visible && defer) && d.mode != detail::DrawMode::DepthOnly)
+                if (i + 1 < end && in_order)
                     detail::prefetch_varyings(job.setups[job.items[i + 1]], d.vertices->data(), job, d.stride);
                 const TriangleSetup& t = job.setups[job.items[i]];
                 switch (d.mode) {
