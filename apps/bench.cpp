@@ -51,6 +51,7 @@
 #include "scene/encode_png.h"
 #include "scene/image.h"
 #include "scene/load_scene.h"
+#include "scene/messages.h"
 #include "shading/resolve.h"
 #include "shading/scene_renderer.h"
 #include "shading/tonemap.h"
@@ -651,15 +652,16 @@ int side_by_side(const std::vector<std::string>& exes, const std::vector<Workloa
                 if (msaa[e]) argv.insert(argv.end(), {"--msaa", std::to_string(samples)});
                 argv.insert(argv.end(), {"--threads", threads, "--stats", "-o", out_png.string()});
                 std::string out;
-                const double ms = run_process(argv, out);
-                if (ms < 0) {
+                auto failed = [&] {
                     std::fprintf(stderr, "bench: %s failed on %s\n", exes[std::size_t(e)].c_str(), w.name.c_str());
                     return 1;
-                }
+                };
+                const double ms = run_process(argv, out);
+                if (ms < 0) return failed();
                 whole[e].push_back(ms);
                 textures[e].push_back(parse_stat(out, "time textures"));
                 argv.insert(argv.end(), {"--repeat", std::to_string(repeat)});
-                run_process(argv, out);
+                if (run_process(argv, out) < 0) return failed();
                 frame[e].push_back(parse_median(out));
             }
         const Summary wa = summarise(whole[0]), wb = summarise(whole[1]);
@@ -906,9 +908,17 @@ int main(int argc, char** argv) {
             std::printf("workloads written to %s (render command lines in commands.txt)\n", write_dir.c_str());
             return 0;
         }
+        const std::vector<Workload> all = workloads(dir, assets);
+        for (const std::string& name : names)
+            if (std::none_of(all.begin(), all.end(), [&](const Workload& w) { return w.name == name; })) {
+                std::string known;
+                for (const Workload& w : all) known += (known.empty() ? "" : ", ") + w.name;
+                std::fprintf(stderr, "bench: unknown workload '%s' (%s)\n", printable(name).c_str(), known.c_str());
+                return 2;
+            }
         ensure_workloads(dir, false);
         std::vector<Workload> list;
-        for (const Workload& w : workloads(dir, assets)) {
+        for (const Workload& w : all) {
             if (!names.empty() && std::find(names.begin(), names.end(), w.name) == names.end()) continue;
             if (!w.file.empty() && !fs::exists(w.file)) {
                 std::fprintf(stderr, "bench: skipping %s: %s not found (--assets DIR)\n", w.name.c_str(),
