@@ -4,7 +4,10 @@
 // thread count; the bytes do not depend on the thread count.
 #include <doctest/doctest.h>
 
+#include <atomic>
 #include <cstdint>
+#include <functional>
+#include <new>
 #include <random>
 #include <vector>
 
@@ -76,6 +79,47 @@ TEST_CASE("PNG bytes do not depend on the thread count") {
     CHECK(decode_exact(one, 333, 517, 3) == px);
     // It compresses: these pixels are a third noise.
     CHECK(one.size() < px.size());
+}
+
+TEST_CASE("a band that throws on a worker thread reaches the caller after every thread has joined") {
+    // Out of memory inside a band: the exception must come out of
+    // parallel_for, not terminate the process, and no band may run after it
+    // returns (the bands' data is gone then).
+    for (int threads : {2, 3, 8})
+        for (int bad : {0, 5, 19}) {
+            CAPTURE(threads);
+            CAPTURE(bad);
+            std::atomic<int> running{0}, after{0};
+            std::atomic<bool> returned{false};
+            const PngOptions o = png_options_threads(threads);
+            REQUIRE(o.parallel_for);
+            CHECK_THROWS_AS(o.parallel_for(20,
+                                           [&](int b) {
+                                               ++running;
+                                               after += returned.load();
+                                               if (b == bad) {
+                                                   --running;
+                                                   throw std::bad_alloc();
+                                               }
+                                               --running;
+                                           }),
+                            std::bad_alloc);
+            returned = true;
+            CHECK(running == 0);
+            CHECK(after == 0);
+        }
+    // And through encode_png_pixels: no band's result is used.
+    const std::vector<std::uint8_t> px = test_pixels(64, 64, 3, 3);
+    PngOptions o = png_options_threads(2);
+    const auto inner = o.parallel_for;
+    o.parallel_for = [&](int count, const std::function<void(int)>& fn) {
+        inner(count, [&](int b) {
+            if (b == count / 2) throw std::bad_alloc();
+            fn(b);
+        });
+    };
+    o.band_rows = 4;
+    CHECK_THROWS_AS(encode_png_pixels(px.data(), 64, 64, 3, o), std::bad_alloc);
 }
 
 TEST_CASE("write_image's encode_png drops alpha and keeps RGB exactly") {
