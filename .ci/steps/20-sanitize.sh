@@ -13,8 +13,8 @@ launcher=""
 [ -n "$CMAKE_CXX_COMPILER_LAUNCHER" ] && launcher="-DCMAKE_CXX_COMPILER_LAUNCHER=$CMAKE_CXX_COMPILER_LAUNCHER"
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" -DPRAST_SANITIZE=ON $launcher >/dev/null
 # Only what the suite runs: the test binary and the executables it drives
-# (bench and the examples are built and tested by the Release run already).
-cmake --build build-asan -j2 --target prast_tests render step prast-diff
+# (the examples are built and tested by the Release run already).
+cmake --build build-asan -j2 --target prast_tests render step prast-diff bench
 built=$(date +%s)
 export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:check_initialization_order=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:suppressions=$PWD/tests/ubsan.supp"
