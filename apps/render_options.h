@@ -18,10 +18,10 @@
 
 #include "raster/limits.h"
 #include "scene/camera_request.h"
-#include "shading/background.h"
+#include "shading/ibl/background.h"
 #include "shading/brdf.h"
 #include "shading/debug_view.h"
-#include "shading/memory_plan.h"
+#include "renderer/memory_plan.h"
 #include "shading/surface.h"
 #include "shading/tonemap.h"
 

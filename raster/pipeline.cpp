@@ -11,7 +11,7 @@
 #include <immintrin.h>
 #endif
 
-#include "raster/resolve.h"
+#include "raster/tile_storage.h"
 
 namespace prast {
 

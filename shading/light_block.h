@@ -17,7 +17,7 @@
 
 #include "raster/limits.h"
 #include "shading/brdf.h"
-#include "shading/shadow_lanes.h"
+#include "shading/shadow/shadow_lanes.h"
 #include "shading/surface.h"
 
 namespace prast {

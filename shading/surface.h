@@ -11,10 +11,10 @@
 
 #include "shading/brdf.h"
 #include "scene/scene.h"
-#include "shading/dfg.h"
-#include "shading/environment.h"
-#include "shading/ibl_reference.h"
-#include "shading/shadow_map.h"
+#include "shading/ibl/dfg.h"
+#include "shading/ibl/environment.h"
+#include "shading/ibl/ibl_reference.h"
+#include "shading/shadow/shadow_map.h"
 #include "shading/texture.h"
 
 namespace prast {

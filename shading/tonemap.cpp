@@ -7,7 +7,7 @@
 #include <cstddef>
 
 #include "shading/color.h"
-#include "shading/resolve.h"
+#include "shading/output8.h"
 
 namespace prast {
 

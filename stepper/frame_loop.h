@@ -13,8 +13,8 @@
 
 #include "raster/pipeline.h"
 #include "shading/pbr_program.h"
-#include "shading/scene_renderer.h"
-#include "shading/transparency.h"
+#include "renderer/scene_renderer.h"
+#include "renderer/draw_order.h"
 #include "stepper/scene_setup.h"
 
 namespace prast::stepper {

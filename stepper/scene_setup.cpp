@@ -9,7 +9,7 @@
 #include "scene/image.h"
 #include "scene/load_environment.h"
 #include "scene/load_scene.h"
-#include "shading/memory_plan.h"
+#include "renderer/memory_plan.h"
 
 namespace prast::stepper {
 

@@ -14,7 +14,7 @@
 
 #include "raster/pipeline.h"
 #include "scene/scene.h"
-#include "shading/scene_renderer.h"
+#include "renderer/scene_renderer.h"
 #include "shading/tonemap.h"
 
 namespace prast::stepper {

@@ -10,7 +10,7 @@
 
 #include "raster/thread_pool.h"
 #include "shading/brdf.h"
-#include "shading/dfg.h"
+#include "shading/ibl/dfg.h"
 #include "shading/surface.h"
 
 using namespace prast;

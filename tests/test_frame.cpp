@@ -17,7 +17,7 @@
 #include <glm/glm.hpp>
 
 #include "raster/stream_fill.h"
-#include "shading/resolve.h"
+#include "shading/output8.h"
 #include "shading/tonemap.h"
 #include "tests/raster_test_util.h"
 

@@ -19,11 +19,11 @@
 #include "raster/thread_pool.h"
 #include "scene/load_environment.h"
 #include "scene/mesh_gen.h"
-#include "shading/dfg.h"
-#include "shading/environment.h"
-#include "shading/ibl_sampling.h"
-#include "shading/prefilter.h"
-#include "shading/scene_renderer.h"
+#include "shading/ibl/dfg.h"
+#include "shading/ibl/environment.h"
+#include "shading/ibl/ibl_sampling.h"
+#include "shading/ibl/prefilter.h"
+#include "renderer/scene_renderer.h"
 #include "shading/surface.h"
 
 using namespace prast;

@@ -14,7 +14,7 @@
 #include "scene/image_diff.h"
 #include "scene/write_image.h"
 #include "scene/load_scene.h"
-#include "shading/scene_renderer.h"
+#include "renderer/scene_renderer.h"
 #include "shading/tonemap.h"
 
 using namespace prast;

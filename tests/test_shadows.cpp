@@ -12,7 +12,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/default_scene.h"
-#include "shading/scene_renderer.h"
+#include "renderer/scene_renderer.h"
 #include "shading/tonemap.h"
 
 using namespace prast;

@@ -14,8 +14,8 @@
 
 #include "scene/default_scene.h"
 #include "shading/color.h"
-#include "shading/resolve.h"
-#include "shading/scene_renderer.h"
+#include "shading/output8.h"
+#include "renderer/scene_renderer.h"
 #include "shading/tonemap.h"
 
 using namespace prast;

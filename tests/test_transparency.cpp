@@ -8,8 +8,8 @@
 #include <glm/glm.hpp>
 
 #include "scene/default_scene.h"
-#include "shading/scene_renderer.h"
-#include "shading/transparency.h"
+#include "renderer/scene_renderer.h"
+#include "renderer/draw_order.h"
 
 using namespace prast;
 

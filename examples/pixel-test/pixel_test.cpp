@@ -22,7 +22,7 @@
 #include <prast/scene/image_diff.h>
 #include <prast/scene/load_scene.h>
 #include <prast/scene/write_image.h>
-#include <prast/shading/scene_renderer.h>
+#include <prast/renderer/scene_renderer.h>
 #include <prast/shading/tonemap.h>
 
 namespace {

@@ -18,7 +18,7 @@
 #include <glm/glm.hpp>
 
 #include "shading/brdf.h"
-#include "shading/environment.h"
+#include "shading/ibl/environment.h"
 
 namespace prast {
 

@@ -27,8 +27,8 @@
 #include "raster/thread_pool.h"
 #include "scene/image.h"
 #include "shading/brdf.h"
-#include "shading/equirect.h"
-#include "shading/sh_irradiance.h"
+#include "shading/ibl/equirect.h"
+#include "shading/ibl/sh_irradiance.h"
 
 namespace prast {
 

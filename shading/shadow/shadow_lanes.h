@@ -14,7 +14,7 @@
 
 
 #include "raster/limits.h"
-#include "shading/shadow_map.h"
+#include "shading/shadow/shadow_map.h"
 #include "shading/simd.h"
 
 namespace prast {

@@ -15,7 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "raster/thread_pool.h"
-#include "shading/equirect.h"
+#include "shading/ibl/equirect.h"
 
 namespace prast {
 

@@ -1,4 +1,4 @@
-#include "shading/memory_plan.h"
+#include "renderer/memory_plan.h"
 
 #include <algorithm>
 #include <set>
@@ -8,7 +8,7 @@
 
 #include "scene/image.h"
 #include "scene/messages.h"
-#include "shading/environment.h"
+#include "shading/ibl/environment.h"
 
 namespace prast {
 

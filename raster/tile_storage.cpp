@@ -1,5 +1,5 @@
 // Tile storage at the start and the end of a tile pass; see resolve.h.
-#include "raster/resolve.h"
+#include "raster/tile_storage.h"
 
 #include <algorithm>
 #include <cstring>

@@ -1,12 +1,12 @@
 // Building an Environment; see environment.h.
-#include "shading/environment.h"
+#include "shading/ibl/environment.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
-#include "shading/prefilter.h"
+#include "shading/ibl/prefilter.h"
 
 namespace prast {
 

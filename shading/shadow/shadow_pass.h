@@ -27,7 +27,7 @@
 #include "raster/pipeline.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
-#include "shading/shadow_map.h"
+#include "shading/shadow/shadow_map.h"
 #include "shading/surface.h"
 
 namespace prast {

@@ -12,7 +12,7 @@
 
 #include "raster/frame.h"
 #include "scene/camera.h"
-#include "shading/environment.h"
+#include "shading/ibl/environment.h"
 
 namespace prast {
 

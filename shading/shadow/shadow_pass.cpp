@@ -1,5 +1,5 @@
 // Fitting and drawing the shadow maps of a frame; see shadow_pass.h.
-#include "shading/shadow_pass.h"
+#include "shading/shadow/shadow_pass.h"
 
 #include <algorithm>
 #include <cmath>

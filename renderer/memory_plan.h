@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "scene/scene.h"
-#include "shading/shadow_map.h"
+#include "shading/shadow/shadow_map.h"
 #include "shading/surface.h"
 
 namespace prast {

@@ -1,5 +1,5 @@
 // Spherical-harmonic projection of an equirect map; see sh_irradiance.h.
-#include "shading/sh_irradiance.h"
+#include "shading/ibl/sh_irradiance.h"
 
 #include <cmath>
 #include <vector>

@@ -3,7 +3,7 @@
 // operators, Srgb8Encoder's table walk), so the bytes are the same: the GCC
 // vector extension gives lane-wise IEEE arithmetic, and comparisons and
 // selects are written to treat NaN as the scalar code's if/else does.
-#include "shading/resolve.h"
+#include "shading/output8.h"
 
 #include <cmath>
 #include <cstring>

@@ -1,10 +1,10 @@
 // The reference integral of the reflectance equation; see ibl_reference.h.
-#include "shading/ibl_reference.h"
+#include "shading/ibl/ibl_reference.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "shading/ibl_sampling.h"
+#include "shading/ibl/ibl_sampling.h"
 
 namespace prast {
 

@@ -52,8 +52,8 @@
 #include "scene/image.h"
 #include "scene/load_scene.h"
 #include "scene/messages.h"
-#include "shading/resolve.h"
-#include "shading/scene_renderer.h"
+#include "shading/output8.h"
+#include "renderer/scene_renderer.h"
 #include "shading/tonemap.h"
 
 using namespace prast;

@@ -1,11 +1,11 @@
 // Resampling and GGX prefiltering of equirect levels; see prefilter.h.
-#include "shading/prefilter.h"
+#include "shading/ibl/prefilter.h"
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "shading/ibl_sampling.h"
+#include "shading/ibl/ibl_sampling.h"
 
 namespace prast {
 

@@ -1,5 +1,5 @@
 // Drawing order of blended meshes; see transparency.h.
-#include "shading/transparency.h"
+#include "renderer/draw_order.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,11 +1,11 @@
 // Building the DFG tables; see dfg.h.
-#include "shading/dfg.h"
+#include "shading/ibl/dfg.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "shading/brdf.h"
-#include "shading/ibl_sampling.h"
+#include "shading/ibl/ibl_sampling.h"
 
 namespace prast {
 

@@ -1,5 +1,5 @@
 // The background a frame clears to; see background.h.
-#include "shading/background.h"
+#include "shading/ibl/background.h"
 
 #include <algorithm>
 #include <cmath>

@@ -49,7 +49,7 @@
 #include "scene/image.h"
 #include "scene/load_scene.h"
 #include "scene/write_image.h"
-#include "shading/scene_renderer.h"
+#include "renderer/scene_renderer.h"
 
 using namespace prast;
 
@@ -341,7 +341,7 @@ int main(int argc, char** argv) {
     if (!err.empty()) die(err, 2);
     if (opt.help) {
         // render's usage: bench --side-by-side reads the flags it lists (--msaa).
-        std::printf("llvmpipe-render: render's command line, drawn by Mesa's llvmpipe (see apps/llvmpipe_render.cpp;\n"
+        std::printf("llvmpipe-render: render's command line, drawn by Mesa's llvmpipe (see tools/llvmpipe/llvmpipe_render.cpp;\n"
                     "llvmpipe draws 1 or 4 samples: --msaa 2 runs at 4, --msaa 8 is refused)\n%s",
                     render_usage());
         return 0;

@@ -1,6 +1,6 @@
 // Texture binding and frame rendering for a Scene; see scene_renderer.h.
-#include "shading/scene_renderer.h"
-#include "shading/transparency.h"
+#include "renderer/scene_renderer.h"
+#include "renderer/draw_order.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <new>
 
 #include "scene/image.h"
-#include "shading/resolve.h"
+#include "shading/output8.h"
 
 namespace prast {
 
