@@ -52,8 +52,7 @@ struct FrameOptions {
     ClearFill clear_fill = nullptr;
     const void* clear_user = nullptr;
     // Shade each sample's winner once (the visibility pass): in every tile
-    // (Always), never (every draw shaded in submission order, as draw calls
-    // used to), or in the tiles whose triangles cover more than
+    // (Always), never (every draw shaded in submission order), or in the tiles whose triangles cover more than
     // kOverdrawForVisibility times their area (Auto: elsewhere the pass costs
     // more than the shading it saves). The bytes are the same in every mode.
     enum class Visibility : std::uint8_t { Auto, Always, Never };

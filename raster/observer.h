@@ -6,7 +6,7 @@
 //
 // Fragments. fragments() reports every 4x4 block a triangle covers, in
 // submission order per tile, with the depth test's result at that point of
-// the sequence: exactly the old draw-by-draw result, whether the draw is
+// the sequence: the result drawing one draw at a time would give, whether the draw is
 // shaded in order or through the visibility pass. shaded() reports what the
 // fragment program was run for and wrote:
 //  - draws shaded in order (blending, alpha MASK, depth test or write off):

@@ -3,8 +3,7 @@
 // per pixel per triangle whatever the sample count), and write its output to
 // the samples it owns, replacing or blending. Two callers:
 //  - shade_in_order(): draws shaded in submission order (blending, alpha
-//    MASK, depth test or write off): depth test, shade, write, as a draw
-//    call always did;
+//    MASK, depth test or write off): depth test, shade, write;
 //  - shade_winner(): the visibility pass already wrote depth and chose each
 //    sample's winner; this shades a winning triangle for the pixels it won
 //    (with the whole block's helper lanes, so derivatives are unchanged).

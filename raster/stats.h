@@ -26,7 +26,7 @@ struct FrameStats {
     std::uint64_t fragments_shader_killed = 0; // discarded by the shader (alpha mask)
     // Passed the depth test and not discarded, in submission order: written at
     // once (draws shaded in order) or the pixel's winner until a later one
-    // passes (the visibility pass); the old draw-by-draw count either way.
+    // passes (the visibility pass); the count drawing one draw at a time would give, either way.
     std::uint64_t fragments_written = 0;
     std::uint64_t fragments_shaded = 0;    // live lanes the fragment program ran for
     double ms_vertex = 0, ms_setup_bin = 0, ms_raster = 0;

@@ -231,7 +231,7 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
     // Evaluate Fresnel factor F.
     float metallic = in.metallic;
     if (in.conductor != Conductor::None) {
-        // The conductor Fresnel (Schlick form with complex index); its
+        // Conductor Fresnel: the Schlick form with a complex index; its
         // error against the exact equations is measured in test_brdf.cpp.
         ConductorIOR ior = conductor_ior(in.conductor);
         t.F = F_ConductorSchlick(ior.eta, ior.k, t.VoH);

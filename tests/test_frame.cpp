@@ -217,7 +217,7 @@ TEST_SUITE("frame") {
 
 TEST_CASE("frame: many draws in one frame equal the same draws drawn one by one") {
     const OverdrawScene sc(203, 131, 7, true);
-    // Draw by draw over a cleared target, shading in order: the old path.
+    // Draw by draw over a cleared target, each draw its own frame, shading in order.
     Renderer r({2, 64});
     Framebuffer fb(sc.W, sc.H);
     fb.clear(0.25f, 0.5f, 0.125f, 1.0f);

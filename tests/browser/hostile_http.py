@@ -1,4 +1,4 @@
-"""`step --serve` under hostile input (issue 12), over raw sockets on loopback.
+"""`step --serve` under hostile input, over raw sockets on loopback.
 
 run(port) asserts, against a running server:
 - every bad request (malformed or oversized request lines and headers,

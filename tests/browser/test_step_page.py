@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The stepper's web page in a real browser (issue 10).
+"""The stepper's web page in a real browser.
 
 Starts `step --serve --port 0` on 127.0.0.1, opens the page in headless
 Chromium through Selenium, clicks a pixel of the frame and checks that the
