@@ -1,7 +1,7 @@
-// render: the command-line renderer (issue 4). Parses the options
-// (render_options.h), loads the scene or builds the default one, frames the
-// camera, and renders one image or a turntable with the library's
-// SceneRenderer; everything else lives in shading/ and raster/. Errors are one
+// render: the command-line renderer. Parses the options (render_options.h),
+// sets up the frame (renderer/frame_setup.h: scene, camera, lights, memory
+// plan, environment) and renders one image or a turntable with the library's
+// SceneRenderer; everything else lives in renderer/, shading/ and raster/. Errors are one
 // line on stderr, "render: ...": exit code 2 for usage, 1 for bad files and
 // failed writes. Output is written atomically (temporary file, then rename);
 // SIGINT/SIGTERM remove the temporary file and end the process by the signal
@@ -30,20 +30,16 @@
 
 #include <glm/glm.hpp>
 
+#include "apps/frame_request.h"
 #include "apps/render_options.h"
 #include "raster/pipeline.h"
+#include "renderer/frame_setup.h"
+#include "renderer/scene_renderer.h"
 #include "scene/camera.h"
-#include "scene/camera_request.h"
-#include "scene/default_scene.h"
-#include "scene/image.h"
-#include "scene/load_environment.h"
-#include "scene/load_scene.h"
 #include "scene/messages.h"
 #include "scene/write_image.h"
 #include "shading/ibl/environment.h"
-#include "renderer/memory_plan.h"
 #include "shading/output8.h"
-#include "renderer/scene_renderer.h"
 #include "shading/surface.h"
 #include "shading/tonemap.h"
 
@@ -58,7 +54,7 @@ double ms_since(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-// Exit codes (issue 4).
+// Exit codes.
 constexpr int kExitBadFile = 1;
 constexpr int kExitUsage = 2;
 
@@ -371,121 +367,50 @@ int run(int argc, char** argv) {
         return code;
     };
 
-    // Load the scene, or build the default one with its own camera.
-    progress.begin(0, opt.scene.empty() ? "building the default scene" : "loading " + opt.scene);
-    auto t_load = Clock::now();
-    Scene scene;
-    Camera camera;
-    if (opt.scene.empty()) {
-        DefaultScene d = make_default_scene();
-        scene = std::move(d.scene);
-        camera = d.camera;
-    } else {
-        g_stage = "loading " + opt.scene;
-        LoadOptions load_options;
-        load_options.allow_outside_paths = opt.allow_outside_paths;
-        try {
-            scene = load_scene(opt.scene, load_options);
-        } catch (const LoadError& e) {
-            return fail(kExitBadFile, e.what());
+    // The frame: scene, camera, lights, memory plan, environment, renderer.
+    const FrameRequest request = render_frame_request(opt);
+    FrameSetup frame;
+    auto on_stage = [&](FrameStage stage) {
+        switch (stage) {
+        case FrameStage::Load:
+            progress.begin(0, opt.scene.empty() ? "building the default scene" : "loading " + opt.scene);
+            if (!opt.scene.empty()) g_stage = "loading " + opt.scene;
+            break;
+        case FrameStage::PlanMemory: g_stage = "planning memory"; break;
+        case FrameStage::StartThreads:
+            progress.begin(1, "decoding textures");
+            g_stage = "starting threads";
+            break;
+        case FrameStage::DecodeTextures: g_stage = "decoding textures"; break;
+        case FrameStage::PrefilterEnvironment: progress.begin(1, "prefiltering the environment"); break;
         }
+    };
+    FrameError setup_err;
+    try {
+        setup_err = setup_frame(request, frame, on_stage);
+    } catch (...) {
+        for (const std::string& n : frame.notes) progress.note("render: " + n);  // before main's one line
+        throw;
     }
-    const double load_ms = ms_since(t_load);
-    for (const std::string& w : cap_warnings(scene.warnings)) progress.note("render: warning: " + w);
-
-    // Camera: the default scene's own, or framed on the bounds; flags override
-    // single fields, and the framing fills in the rest.
-    const Bounds bounds = scene.bounds();
-    const float aspect = float(opt.width) / float(opt.height);
-    const CameraRequest camera_request = opt.camera_request();
-    if (CameraFault f = request_camera(camera_request, bounds, aspect, !opt.scene.empty(), camera, camera))
-        return fail(f.kind == CameraFault::Flag ? kExitUsage : kExitBadFile, f.message);
-
-    // Lights: the scene's and the flags'; the default rig only when neither has
-    // any and no environment (--env, or the scene's own sky) lights the scene.
-    FrameSettings settings;
-    bool used_default_rig = false;
-    settings.lights = frame_lights(scene, opt.lights, opt.no_default_lights, scene.environment || !opt.env.empty(),
-                                   used_default_rig);
-
-    // The whole render must fit in memory before anything big is allocated.
-    g_stage = "planning memory";
-    MemoryPlan plan = plan_memory(scene, opt.width, opt.height, kBytesPerPixel);
-    plan_environment(plan, scene, opt.env);
-    plan_shadows(plan, settings.lights, opt.shadows);
-    const std::uint64_t budget = memory_budget();
-    if (plan.total() > budget)
-        return fail(kExitBadFile, (opt.scene.empty() ? std::string("the built-in scene") : opt.scene) +
-                                      ": the render needs " + plan.describe() + ", more than the " +
-                                      std::to_string(budget) + " bytes allowed (half the physical memory)");
-
-    // The environment: --env, or the scene's own (the built-in sky).
-    std::shared_ptr<const Image> env_image = scene.environment;
-    if (!opt.env.empty()) {
-        try {
-            env_image = std::make_shared<const Image>(load_environment_hdr(opt.env));
-        } catch (const LoadError& e) {
-            return fail(kExitBadFile, e.what());
-        }
-    }
-
-    if (used_default_rig)
-        progress.note("render: no lights in the scene or flags: using the default key+fill rig "
-                      "(--no-default-lights to disable)");
-    if (env_image && opt.ambient_given)
-        progress.note("render: warning: --ambient is not used: the environment map replaces the ambient term");
-    settings.ambient = opt.ambient;
-    settings.model = opt.brdf;
-    settings.view = opt.view;
-    settings.ibl = opt.ibl;
-    settings.ibl_samples = opt.ibl_samples;
-    settings.energy = opt.energy;
-    settings.background = opt.background;
-    settings.background_color = opt.background_color;
-    settings.samples = opt.msaa;
-    settings.shadows = opt.shadows;
-
-    progress.begin(1, "decoding textures");
-    auto t_tex = Clock::now();
-    RendererOptions ro;
-    ro.threads = opt.threads;
-    ro.tile_size = opt.tile_size;
-    g_stage = "starting threads";
-    Renderer renderer(ro);
-    if (!renderer.pool().started_fewer().empty())
-        progress.note("render: warning: " + renderer.pool().started_fewer() + "; rendering with " +
-                      std::to_string(renderer.threads()));
-    g_stage = "decoding textures";
-    SceneRenderer scene_renderer(scene, renderer);
-    const double textures_ms = ms_since(t_tex);
-    for (const std::string& w : cap_warnings(scene_renderer.warnings())) progress.note("render: warning: " + w);
-
-    // Prefilter the environment once for all frames, on the renderer's threads.
-    auto t_env = Clock::now();
-    std::unique_ptr<Environment> environment;
-    if (env_image) {
-        progress.begin(1, "prefiltering the environment");
-        EnvironmentSettings es;
-        es.intensity = opt.env_intensity;
-        es.rotate_deg = opt.env_rotate_deg;
-        es.importance_sampling = opt.ibl == IblMode::Reference || opt.pixel.has_value();
-        environment = std::make_unique<Environment>(Environment::build(*env_image, es, renderer.pool()));
-    }
-    settings.environment = environment.get();
-    settings.scene_environment = false;
-    const double env_ms = ms_since(t_env);
+    for (const std::string& n : frame.notes) progress.note("render: " + n);
+    if (setup_err) return fail(setup_err.code, setup_err.message);
+    const Scene& scene = frame.scene;
+    Renderer& renderer = *frame.renderer;
+    SceneRenderer& scene_renderer = *frame.scene_renderer;
+    const Environment* environment = frame.environment.get();
+    FrameSettings& settings = frame.settings;
 
     if (opt.stats) {
         std::printf("scene                  %zu triangles, %zu meshes, %zu materials, %zu images\n"
                     "time load              %.3f ms\ntime textures          %.3f ms\nthreads                %d, "
                     "tile %d\n",
                     scene.triangle_count(), scene.meshes.size(), scene.materials.size(), scene.images.size(),
-                    load_ms, textures_ms, renderer.threads(), renderer.tile_size());
+                    frame.load_ms, frame.textures_ms, renderer.threads(), renderer.tile_size());
         if (environment) {
             const EnvironmentTimings& et = environment->timings();
             std::printf("environment            %dx%d\ntime environment       %.3f ms (mips %.3f, sh %.3f, "
                         "prefilter %.3f, sampler %.3f)\n",
-                        environment->width(), environment->height(), env_ms, et.mips, et.sh, et.prefilter,
+                        environment->width(), environment->height(), frame.environment_ms, et.mips, et.sh, et.prefilter,
                         et.sampler);
         }
     }
@@ -504,16 +429,15 @@ int run(int argc, char** argv) {
     out8.keep_framebuffer = opt.pixel.has_value();  // --pixel reads the linear colour and depth
     std::vector<double> frame_ms;
     int step = 2;
-    for (int frame = opt.first_frame; frame <= opt.last_frame; ++frame) {
+    for (int index = opt.first_frame; index <= opt.last_frame; ++index) {
         // Frame i of a turntable sits at angle i * DEG / N around the target.
-        const double angle = glm::radians(double(frame) * opt.orbit_deg / double(opt.frames));
-        if (CameraFault f = orbit_camera(camera_request, camera, bounds, angle, settings.camera))
-            return fail(kExitUsage, f.message);
+        const double angle = glm::radians(double(index) * opt.orbit_deg / double(opt.frames));
+        if (CameraFault f = frame.orbit(angle)) return fail(kExitUsage, f.message);
 
         double render_ms = 0.0;
         for (int r = 0; r < opt.repeat; ++r) {
-            progress.begin(step++, "frame " + std::to_string(frame));
-            g_stage = "rendering frame " + std::to_string(frame);
+            progress.begin(step++, "frame " + std::to_string(index));
+            g_stage = "rendering frame " + std::to_string(index);
             auto t0 = Clock::now();
             scene_renderer.render(settings, fb, opt.hdr_output() ? nullptr : &out8);
             render_ms = ms_since(t0);
@@ -521,7 +445,7 @@ int run(int argc, char** argv) {
         }
 
         auto t_write = Clock::now();
-        const std::string path = pattern.format(frame);
+        const std::string path = pattern.format(index);
         progress.begin(step, "writing " + path);
         g_stage = "writing " + path;
         try {
@@ -532,10 +456,10 @@ int run(int argc, char** argv) {
         }
         if (opt.stats) {
             std::printf("frame                  %d\n%stime frame+resolve     %.3f ms\ntime write             %.3f ms\n",
-                        frame, renderer.stats().to_string().c_str(), render_ms, ms_since(t_write));
+                        index, renderer.stats().to_string().c_str(), render_ms, ms_since(t_write));
         }
         if (opt.pixel)
-            print_pixel(scene, settings.camera, fb, rgba8, *opt.pixel, frame, scene_renderer, settings,
+            print_pixel(scene, settings.camera, fb, rgba8, *opt.pixel, index, scene_renderer, settings,
                         opt.samples_given ? opt.ibl_samples : 4096);
         std::fflush(stdout);
     }

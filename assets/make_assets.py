@@ -214,7 +214,7 @@ def make_cornell():
 # A UV sphere of radius 1: u runs with longitude (u = 0.5 faces +Z, u grows
 # towards +X there), v = 0 is the north pole (+Y) and the top image row, as
 # glTF has it. Tangents point along +u with w = +1, so the bitangent
-# cross(N, T) points north, up the image (conventions.md, "Normal mapping").
+# cross(N, T) points north, up the image (docs/conventions.md, "Normal mapping").
 
 TEX_W, TEX_H = 128, 64
 CELL = 16  # checker cell in texels: 8 x 4 cells
@@ -350,7 +350,7 @@ def make_sphere_gltf(segments=32, rings=16):
 
 
 # ---- Studio environment (Radiance HDR) ----------------------------------------
-# 128 x 64 equirectangular (conventions.md, "Environment maps": row 0 looks up,
+# 128 x 64 equirectangular (docs/conventions.md, "Environment maps": row 0 looks up,
 # the centre column looks along -Z, u grows towards +X): a dim warm floor, a
 # grey-blue dome brighter towards the zenith, a large warm key soft box front
 # left (u = 0.125, 35 degrees up), a cooler fill strip front right and a rim

@@ -12,14 +12,14 @@
 
 #include "fuzz/targets.h"
 #include "stepper/recording.h"
-#include "stepper/scene_setup.h"
+#include "renderer/frame_setup.h"
 #include "stepper/session.h"
 
 namespace {
 
 using namespace prast::stepper;
 
-StepScene g_scene;
+prast::FrameSetup g_scene;
 Recording g_rec;
 Session* g_session = nullptr;
 
@@ -29,12 +29,12 @@ Session* g_session = nullptr;
 // (the built-in scene's procedural textures take seconds in this build).
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
     if (chdir(prast::fuzz::make_model_dir("step").c_str()) != 0) __builtin_trap();
-    FrameRequest req;
+    prast::FrameRequest req;
     req.width = 48;
     req.height = 32;
     req.threads = 1;
-    SetupError err;
-    if (!setup_scene(req, g_scene, err)) __builtin_trap();
+    req.recording = true;
+    if (prast::setup_frame(req, g_scene) || g_scene.orbit(0.0)) __builtin_trap();
     record_frame(g_scene, g_rec);
     g_session = new Session(g_scene, g_rec);
     return 0;

@@ -19,7 +19,7 @@ struct DrawState {
     // The fragment program may set FragmentOut::kill (alpha MASK). Such draws
     // are shaded in submission order, like blending draws and draws without
     // depth test or write; every other draw gets the visibility pass (each
-    // sample's winner shaded once, see README "The pipeline"). A program that
+    // sample's winner shaded once, see docs/pipeline.md). A program that
     // kills without this flag set breaks that contract: its kills are honoured
     // only as "colour not written" after the depth was already written.
     bool may_discard = false;

@@ -33,7 +33,7 @@
 namespace prast {
 
 struct FrameOptions {
-    int samples = 1;        // per pixel: 1, 2, 4 or 8 (README "Anti-aliasing")
+    int samples = 1;        // per pixel: 1, 2, 4 or 8 (docs/pipeline.md "Anti-aliasing")
     bool clear = true;      // clear colour and depth in the tile pass; false: draw over the target
     float clear_color[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     float clear_depth = 1.0f;
@@ -60,8 +60,7 @@ struct FrameOptions {
 };
 
 // Auto visibility: the estimated overdraw (covered area over the tile's
-// area) above which a tile takes the visibility pass. Measured: README "The
-// pipeline".
+// area) above which a tile takes the visibility pass. Measured: docs/pipeline.md, "A frame".
 constexpr float kOverdrawForVisibility = 1.5f;
 
 // A finished tile's linear colour, for a frame's tile hook: pixel (x0 + i,

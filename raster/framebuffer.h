@@ -4,7 +4,7 @@
 // A deferred target (deferred(w, h)) has a size and no storage until a frame
 // keeps its pixels.
 // A multisampled frame keeps its samples in tile-local buffers and leaves here
-// the resolved colour and each pixel's nearest sample depth (README "Anti-aliasing").
+// the resolved colour and each pixel's nearest sample depth (docs/pipeline.md "Anti-aliasing").
 #pragma once
 
 #include <algorithm>

@@ -6,7 +6,7 @@
 
 namespace prast {
 
-// Vertex positions are snapped to 1/256 pixel before edge setup (conventions.md).
+// Vertex positions are snapped to 1/256 pixel before edge setup (docs/conventions.md).
 constexpr int kSubPixelBits = 8;
 constexpr std::int64_t kSubPixelScale = std::int64_t(1) << kSubPixelBits;
 constexpr std::int64_t kHalfPixel = kSubPixelScale / 2;
@@ -33,8 +33,8 @@ constexpr int kBlockSize = 4;
 constexpr int kBlockLanes = kBlockSize * kBlockSize;
 constexpr int kCoarseBlockSize = 16;
 
-// Tiles: a power of two between 16 and 256. 64 is the default (see README:
-// "Tile size" for the measurement behind it).
+// Tiles: a power of two between 16 and 256. 64 is the default (docs/pipeline.md, "Tile
+// size", has the measurement behind it).
 constexpr int kDefaultTileSize = 64;
 constexpr int kMinTileSize = 16;
 constexpr int kMaxTileSize = 256;

@@ -36,6 +36,14 @@ struct RendererOptions {
     int tile_size = kDefaultTileSize;     // power of two in [16, 256]
 };
 
+// Whether a draw with a fragment program into a colour target has its
+// winners shaded once, after the visibility pass (else it is shaded in
+// submission order): what submit() chooses, and what the stepper records.
+inline bool shades_after_visibility(const DrawState& state, FrameOptions::Visibility visibility) {
+    return visibility != FrameOptions::Visibility::Never && state.depth_test && state.depth_write &&
+           state.blend == Blend::Replace && !state.may_discard;
+}
+
 class Renderer {
 public:
     explicit Renderer(const RendererOptions& options = {});
@@ -164,8 +172,7 @@ void Renderer::submit(const Program& program, std::uint32_t vertex_count, const 
     using detail::DrawMode;
     if (!has_fragment<Program>::value || (!fb_->has_color() && !state.may_discard)) {
         d->mode = DrawMode::DepthOnly;
-    } else if (options_.visibility != FrameOptions::Visibility::Never && fb_->has_color() && state.depth_test && state.depth_write &&
-               state.blend == Blend::Replace && !state.may_discard) {
+    } else if (fb_->has_color() && shades_after_visibility(state, options_.visibility)) {
         d->mode = DrawMode::Visible;
     } else {
         d->mode = DrawMode::InOrder;

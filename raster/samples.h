@@ -1,5 +1,5 @@
 // Multisampling: the standard sample positions of Direct3D 11 / Vulkan for 1,
-// 2, 4 and 8 samples per pixel (conventions.md, "Multisampling and blending"),
+// 2, 4 and 8 samples per pixel (docs/conventions.md, "Multisampling and blending"),
 // in 1/16 pixel from the pixel centre, y down. With 8 sub-pixel bits a 1/16
 // step is 16 fixed-point units, so every sample lies exactly on the snapping
 // grid and the edge functions stay exact integers at every sample.

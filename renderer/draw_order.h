@@ -1,4 +1,4 @@
-// The order of alpha-BLEND draws (README "Transparency"): after every opaque
+// The order of alpha-BLEND draws (docs/shadows-and-transparency.md): after every opaque
 // and MASK mesh, back to front by the distance from the eye to the centre of
 // each mesh's bounds, a stable sort (equal distances keep file order). They
 // are depth-tested against the opaque surfaces but write no depth, and blend

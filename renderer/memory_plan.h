@@ -2,7 +2,7 @@
 // allocated: before the textures and the environment map are decoded, the
 // shadow maps drawn or a frame started. render and step refuse a job whose
 // plan exceeds the budget (half the physical memory) with the plan in the
-// message, rather than being killed half-way (README "Hostile input").
+// message, rather than being killed half-way (docs/security.md).
 #pragma once
 
 #include <cstdint>

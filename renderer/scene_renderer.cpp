@@ -234,8 +234,32 @@ BackgroundFill frame_background(const FrameSettings& s, const Environment* env, 
     return BackgroundFill(s.camera, width, height, env, lit ? s.background : Background::Black, s.background_color);
 }
 
-void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out) {
-    const ShadingContext ctx = shading_context(s, float(fb.width) / float(fb.height));
+const BoundMaterial& SceneRenderer::material_of(const Mesh& mesh) const {
+    static const Material kFallback;
+    static const BoundMaterial kFallbackBound{&kFallback};
+    return mesh.material >= 0 && std::size_t(mesh.material) < bound_.size() ? bound_[std::size_t(mesh.material)]
+                                                                          : kFallbackBound;
+}
+
+DrawState SceneRenderer::draw_state(const BoundMaterial& bm, DebugView view) {
+    DrawState st;
+    st.cull = bm.m->double_sided ? CullMode::None : CullMode::Back;
+    st.may_discard = bm.m->alpha_mode == AlphaMode::Mask;  // shaded in order: discards decide visibility
+    // BLEND meshes blend over what is drawn in lit views; data views draw them opaque.
+    if (debug_view_is_lit(view) && bm.m->alpha_mode == AlphaMode::Blend) {
+        st.blend = Blend::Alpha;  // per sample, in linear radiance
+        st.depth_write = false;
+    }
+    if (view == DebugView::Overdraw) {
+        st.blend = Blend::Add;
+        st.depth_test = false;
+        st.depth_write = false;
+    }
+    return st;
+}
+
+void SceneRenderer::begin_pass(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out, Pass& pass) {
+    pass.ctx = shading_context(s, float(fb.width) / float(fb.height));  // shadow maps first: not in the frame's counts
     renderer_.begin_frame();
     // Cleared in the tile pass: alpha 1, depth 1, and the background's colour
     // (black unless an environment or a colour is shown), so that samples no
@@ -243,45 +267,30 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
     FrameOptions frame;
     frame.samples = s.samples;
     frame.visibility = s.visibility;
-    const bool overlay = s.view == DebugView::Overdraw || s.view == DebugView::Tiles;
-    frame.transient = out && !out->keep_framebuffer && !overlay;
-    const BackgroundFill background = frame_background(s, ctx.env, fb.width, fb.height);
-    background.attach(frame);
+    pass.overlay = s.view == DebugView::Overdraw || s.view == DebugView::Tiles;
+    frame.transient = out && !out->keep_framebuffer && !pass.overlay;
+    pass.background.emplace(frame_background(s, pass.ctx.env, fb.width, fb.height));
+    pass.background->attach(frame);
     renderer_.begin(fb, frame);
-    const float aspect = float(fb.width) / float(fb.height);
-    const glm::mat4 vp = s.camera.view_projection(aspect);
-    static const Material kFallback;
-    static const BoundMaterial kFallbackBound{&kFallback};
-    // Opaque and MASK meshes in file order, then BLEND ones back to front,
-    // blended over what is drawn (lit views; data views draw them opaque).
-    const bool lit = debug_view_is_lit(s.view);
-    for (const std::size_t mi : draw_order(scene_, s.camera.eye)) {
-        const Mesh& mesh = scene_.meshes[mi];
-        if (mesh.indices.empty()) continue;
-        const BoundMaterial* bm = mesh.material >= 0 && std::size_t(mesh.material) < bound_.size()
-                                      ? &bound_[std::size_t(mesh.material)] : &kFallbackBound;
-        PbrProgram prog;
-        prog.mesh = &mesh;
-        prog.view_proj = vp;
-        prog.material = bm;
-        prog.ctx = &ctx;
-        prog.view = s.view;
-        prog.near_plane = s.camera.near_plane;
-        prog.far_plane = s.camera.far_plane;
-        DrawState st;
-        st.cull = bm->m->double_sided ? CullMode::None : CullMode::Back;
-        st.may_discard = bm->m->alpha_mode == AlphaMode::Mask;  // shaded in order: discards decide visibility
-        if (lit && bm->m->alpha_mode == AlphaMode::Blend) {
-            st.blend = Blend::Alpha;  // per sample, in linear radiance
-            st.depth_write = false;
-        }
-        if (s.view == DebugView::Overdraw) {
-            st.blend = Blend::Add;
-            st.depth_test = false;
-            st.depth_write = false;
-        }
-        renderer_.submit(prog, std::uint32_t(mesh.positions.size()), mesh.indices.data(), mesh.indices.size(), st);
-    }
+    pass.view_proj = s.camera.view_projection(float(fb.width) / float(fb.height));
+    // Opaque and MASK meshes in file order, then BLEND ones back to front.
+    pass.order = draw_order(scene_, s.camera.eye);
+}
+
+PbrProgram SceneRenderer::program(const FrameSettings& s, const Pass& pass, const Mesh& mesh,
+                                  const BoundMaterial& bm) const {
+    PbrProgram prog;
+    prog.mesh = &mesh;
+    prog.view_proj = pass.view_proj;
+    prog.material = &bm;
+    prog.ctx = &pass.ctx;
+    prog.view = s.view;
+    prog.near_plane = s.camera.near_plane;
+    prog.far_plane = s.camera.far_plane;
+    return prog;
+}
+
+void SceneRenderer::end_pass(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out, const Pass& pass) {
     // The 8-bit image: from each finished tile, unless a whole-image overlay
     // comes first (then after it, rows in parallel).
     TileResolve resolve;
@@ -292,11 +301,11 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
         resolve.tonemap = out->tonemap;
         resolve.raw = out->raw;
     }
-    if (out && !overlay) renderer_.end(resolve);
+    if (out && !pass.overlay) renderer_.end(resolve);
     else renderer_.end();
     if (s.view == DebugView::Overdraw) apply_overdraw_heat(fb);
     if (s.view == DebugView::Tiles) apply_tile_overlay(fb, renderer_.tile_entries(), renderer_.tile_size());
-    if (out && overlay) {
+    if (out && pass.overlay) {
         constexpr int kRows = 16;
         renderer_.pool().run((fb.height + kRows - 1) / kRows, [&](int chunk, int) {
             TileView v;
@@ -309,6 +318,10 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
             resolve(v);
         });
     }
+}
+
+void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out) {
+    render(s, fb, out, NoTaps{});
 }
 
 // Fragments per pixel (in red, counted additively) to a heat ramp:

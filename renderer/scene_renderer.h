@@ -3,7 +3,11 @@
 // a linear HDR framebuffer. The render CLI, bench and stepper all go through it.
 #pragma once
 
+#include <algorithm>
+#include <cstdint>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,7 +32,7 @@ struct FrameSettings {
     glm::vec3 ambient{0.03f};
     BrdfModel model = BrdfModel::Default;
     DebugView view = DebugView::None;
-    ShadowSettings shadows;  // shadow maps for the lights (README "Shadows"); not for the environment
+    ShadowSettings shadows;  // shadow maps for the lights (docs/shadows-and-transparency.md); not for the environment
     // Image-based lighting: this environment, or when null the scene's own
     // (Scene::environment, prefiltered on first use) unless scene_environment
     // is false. With one, it replaces the ambient term.
@@ -40,7 +44,7 @@ struct FrameSettings {
     // Env and Blur need an environment (without one they draw black).
     Background background = Background::Env;
     glm::vec3 background_color{0.0f};
-    int samples = 1;  // per pixel: 1, 2, 4 or 8 (README "Anti-aliasing")
+    int samples = 1;  // per pixel: 1, 2, 4 or 8 (docs/pipeline.md "Anti-aliasing")
     // Where the visibility pass runs (the bytes are the same either way).
     FrameOptions::Visibility visibility = FrameOptions::Visibility::Auto;
 };
@@ -71,6 +75,21 @@ std::vector<ShadingLight> default_light_rig();
 std::vector<ShadingLight> frame_lights(const Scene& scene, const std::vector<ShadingLight>& flag_lights,
                                        bool no_default_lights, bool environment, bool& used_default_rig);
 
+// One draw of a frame, as SceneRenderer::render submits it: what a tap
+// factory is told before the frame runs.
+struct SceneDraw {
+    int mesh = -1;                      // index into the scene's meshes
+    std::uint32_t first_triangle = 0;   // submission-order number of the draw's triangle 0
+    std::uint32_t triangle_count = 0;   // the mesh's, also when a limit cuts the draw short
+    std::uint32_t vertex_count = 0;
+    DrawState state;
+};
+
+// A tap factory that watches nothing.
+struct NoTaps {
+    NullObserver operator()(const SceneDraw&) const { return {}; }
+};
+
 class SceneRenderer {
 public:
     // Decodes every texture the materials use. A texture that cannot be
@@ -83,6 +102,18 @@ public:
     // (in the tile pass, on every thread); out->keep_framebuffer false leaves
     // fb as it was.
     void render(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out = nullptr);
+    // The same frame with a stage observer (raster/observer.h) on each draw:
+    // make_tap(const SceneDraw&) gives it, before the frame runs, and the taps
+    // live until the frame is done. Only the first `triangle_limit` triangles
+    // in submission order are drawn ("the image after N triangles").
+    template <class MakeTap>
+    void render(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out, MakeTap&& make_tap,
+                std::uint64_t triangle_limit = std::numeric_limits<std::uint64_t>::max());
+
+    // The material a mesh draws with: its own, or the fallback.
+    const BoundMaterial& material_of(const Mesh& mesh) const;
+    // The state a draw of material `bm` runs with in a frame showing `view`.
+    static DrawState draw_state(const BoundMaterial& bm, DebugView view);
 
     // The environment a frame with these settings is lit by (null: none).
     const Environment* environment(const FrameSettings& settings);
@@ -105,6 +136,19 @@ public:
     Renderer& renderer() { return renderer_; }
 
 private:
+    // A frame between begin_pass() and end_pass(): what its draws point to.
+    struct Pass {
+        ShadingContext ctx;
+        glm::mat4 view_proj{1.0f};
+        bool overlay = false;
+        std::vector<std::size_t> order;
+        std::optional<BackgroundFill> background;  // the frame's clear reads it until end()
+    };
+    void begin_pass(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out, Pass& pass);
+    PbrProgram program(const FrameSettings& settings, const Pass& pass, const Mesh& mesh,
+                       const BoundMaterial& bm) const;
+    void end_pass(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out, const Pass& pass);
+
     const Scene& scene_;
     Renderer& renderer_;
     std::vector<std::unique_ptr<Texture>> textures_;  // [image * 2 + srgb]
@@ -116,6 +160,35 @@ private:
     std::unique_ptr<Environment> scene_env_;   // from Scene::environment, on first use
     std::unique_ptr<DfgTable> dfg_[3];         // by DfgModel, on first use
 };
+
+template <class MakeTap>
+void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out, MakeTap&& make_tap,
+                           std::uint64_t triangle_limit) {
+    using Tap = decltype(make_tap(SceneDraw{}));
+    Pass pass;
+    begin_pass(s, fb, out, pass);
+    std::vector<Tap> taps;
+    taps.reserve(scene_.meshes.size());  // submit() keeps a pointer to each tap
+    std::uint64_t first = 0;
+    for (const std::size_t mi : pass.order) {
+        const Mesh& mesh = scene_.meshes[mi];
+        if (mesh.indices.empty()) continue;
+        if (first >= triangle_limit) break;
+        const BoundMaterial& bm = material_of(mesh);
+        SceneDraw d;
+        d.mesh = int(mi);
+        d.first_triangle = std::uint32_t(first);
+        d.triangle_count = std::uint32_t(mesh.indices.size() / 3);
+        d.vertex_count = std::uint32_t(mesh.positions.size());
+        d.state = draw_state(bm, s.view);
+        const std::uint64_t drawn = std::min<std::uint64_t>(d.triangle_count, triangle_limit - first);
+        taps.push_back(make_tap(d));
+        renderer_.submit(program(s, pass, mesh, bm), d.vertex_count, mesh.indices.data(), std::size_t(drawn) * 3,
+                         d.state, taps.back());
+        first += d.triangle_count;
+    }
+    end_pass(s, fb, out, pass);
+}
 
 // The background a frame with these settings clears to: settings.background
 // for the lit image and the tiles view, black for the other debug views.

@@ -33,22 +33,6 @@ std::uint32_t hash3(int x, int y, std::uint32_t seed) {
 
 float unit_float(std::uint32_t h) { return float(h >> 8) * (1.0f / 16777216.0f); }  // [0, 1)
 
-// Smooth value noise in [0, 1) with `period` lattice cells across [0, 1), so
-// it tiles seamlessly.
-float value_noise(glm::vec2 uv, int period, std::uint32_t seed) {
-    const float x = uv.x * float(period), y = uv.y * float(period);
-    const float fx = std::floor(x), fy = std::floor(y);
-    const int ix = int(fx), iy = int(fy);
-    auto lattice = [&](int i, int j) {
-        return unit_float(hash3(((i % period) + period) % period, ((j % period) + period) % period, seed));
-    };
-    auto smooth = [](float t) { return t * t * (3.0f - 2.0f * t); };
-    const float sx = smooth(x - fx), sy = smooth(y - fy);
-    const float top = lattice(ix, iy) + (lattice(ix + 1, iy) - lattice(ix, iy)) * sx;
-    const float bottom = lattice(ix, iy + 1) + (lattice(ix + 1, iy + 1) - lattice(ix, iy + 1)) * sx;
-    return top + (bottom - top) * sy;
-}
-
 // Brick layout, in brick heights H = 1/8 of the texture: 4 bricks (2H wide)
 // across, 8 rows, odd rows shifted by half a brick (running bond). Both counts
 // divide the texture, so the pattern tiles under Repeat.
@@ -156,6 +140,26 @@ Image render_procedural(int size, F f) {
 constexpr float kGroutAlbedo = 0.28f;
 
 } // namespace
+
+float lattice_value(int x, int y, std::uint32_t seed, NoiseLattice lattice) {
+    if (lattice == NoiseLattice::Linear)
+        return unit_float(hash_u32(std::uint32_t(x) * 73856093U ^ std::uint32_t(y) * 19349663U ^ seed));
+    return unit_float(hash3(x, y, seed));
+}
+
+float value_noise(glm::vec2 uv, int period, std::uint32_t seed, NoiseLattice lattice) {
+    const float x = uv.x * float(period), y = uv.y * float(period);
+    const float fx = std::floor(x), fy = std::floor(y);
+    const int ix = int(fx), iy = int(fy);
+    auto at = [&](int i, int j) {
+        return lattice_value(((i % period) + period) % period, ((j % period) + period) % period, seed, lattice);
+    };
+    auto smooth = [](float t) { return t * t * (3.0f - 2.0f * t); };
+    const float sx = smooth(x - fx), sy = smooth(y - fy);
+    const float top = at(ix, iy) + (at(ix + 1, iy) - at(ix, iy)) * sx;
+    const float bottom = at(ix, iy + 1) + (at(ix + 1, iy + 1) - at(ix, iy + 1)) * sx;
+    return top + (bottom - top) * sy;
+}
 
 Image make_checker(int size, int cells, glm::vec4 a, glm::vec4 b) {
     check_size("make_checker", size);

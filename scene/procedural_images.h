@@ -2,11 +2,24 @@
 // seamless under Repeat): made by code, so no third-party file is involved.
 #pragma once
 
+#include <cstdint>
+
 #include <glm/glm.hpp>
 
 #include "scene/image.h"
 
 namespace prast {
+
+// Which integer hash picks the noise lattice's values: Mixed (the built-in
+// scene's images) or Linear (x * 73856093 ^ y * 19349663 ^ seed, then mixed:
+// the maps of bench's synthetic workloads). Each keeps its images' bytes.
+enum class NoiseLattice { Mixed, Linear };
+
+// The lattice value at integer point (x, y), in [0, 1).
+float lattice_value(int x, int y, std::uint32_t seed, NoiseLattice lattice = NoiseLattice::Mixed);
+// Smooth value noise in [0, 1) with `period` lattice cells across [0, 1)
+// (smoothstep between the four lattice values), so it tiles seamlessly.
+float value_noise(glm::vec2 uv, int period, std::uint32_t seed, NoiseLattice lattice = NoiseLattice::Mixed);
 
 // size x size, cells x cells squares; the top-left cell is `a`.
 Image make_checker(int size, int cells, glm::vec4 a, glm::vec4 b);

@@ -36,12 +36,23 @@ struct ImageSource {
 };
 
 enum class Wrap { Repeat, ClampToEdge, MirroredRepeat };
+// glTF's sampler filters. An absent minFilter is LinearMipmapLinear and an
+// absent magFilter Linear: trilinear, what every texture had before samplers.
+enum class Filter { Nearest, Linear };
+enum class MinFilter {
+    Nearest, Linear, NearestMipmapNearest, LinearMipmapNearest, NearestMipmapLinear, LinearMipmapLinear
+};
+
+// The UV sets a mesh carries: TEXCOORD_0 (Mesh::uvs) and TEXCOORD_1 (Mesh::uvs1).
+constexpr int kMaxUvSets = 2;
 
 struct TextureRef {
     int image = -1;              // index into Scene::images; -1 = none
-    Wrap wrap_s = Wrap::Repeat;
-    Wrap wrap_t = Wrap::Repeat;
-    int texcoord = 0;            // only set 0 is carried; others warn
+    Wrap wrap_s = Wrap::Repeat;  // the texture's own sampler: two textures of
+    Wrap wrap_t = Wrap::Repeat;  // one image may sample it differently
+    Filter mag_filter = Filter::Linear;
+    MinFilter min_filter = MinFilter::LinearMipmapLinear;
+    int texcoord = 0;            // UV set, 0 .. kMaxUvSets - 1
     bool valid() const { return image >= 0; }
 };
 
@@ -81,8 +92,13 @@ struct Mesh {
     std::vector<glm::vec3> normals;    // world space, unit; always filled by loaders
     std::vector<glm::vec2> uvs;        // internal (v = 0 top) convention; may be empty
     std::vector<glm::vec4> tangents;   // xyz + handedness w; filled when uvs exist
-    std::vector<std::uint32_t> indices; // triangle list
+    std::vector<glm::vec2> uvs1;       // TEXCOORD_1, same convention; may be empty
+    std::vector<glm::vec4> colors;     // COLOR_0, linear RGBA (RGB files: a = 1); empty = white
+    std::vector<std::uint32_t> indices; // by topology: triangles, line pairs or points
     int material = 0;                  // index into Scene::materials
+    // Strips, fans and loops are turned into these lists by the loaders.
+    enum class Topology { Triangles, Lines, Points };
+    Topology topology = Topology::Triangles;
 };
 
 struct Light {
@@ -120,7 +136,8 @@ struct Scene {
     }
     std::size_t triangle_count() const {
         std::size_t n = 0;
-        for (const Mesh& m : meshes) n += m.indices.size() / 3;
+        for (const Mesh& m : meshes)
+            if (m.topology == Mesh::Topology::Triangles) n += m.indices.size() / 3;
         return n;
     }
 };

@@ -13,6 +13,7 @@ PACKAGES="
   doctest-dev
   libtinygltf-dev
   nlohmann-json3-dev
+  libcli11-dev
   zlib1g-dev
   libpng-dev
   libcpp-httplib-dev

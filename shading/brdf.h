@@ -1,6 +1,6 @@
 // The reflectance model: Cook-Torrance microfacet specular (GGX D, Smith G or
 // the height-correlated V, Schlick or conductor Fresnel) plus Lambert diffuse,
-// as conventions.md writes it, and the glTF 2.0 / Filament variant. Small pure
+// as docs/conventions.md writes it, and the glTF 2.0 / Filament variant. Small pure
 // inline functions named after the papers (Filament style), so a shader can
 // inline them, plus evaluate_brdf(), which the shaders and the debug stepper
 // both call so that they show the same numbers.
@@ -163,7 +163,7 @@ inline float Fd_Lambert() { return glm::one_over_pi<float>(); }
 
 // ---- Combined evaluation
 
-// Default: conventions.md (Cook-Torrance, Smith/Schlick-GGX G with k_direct).
+// Default: docs/conventions.md (Cook-Torrance, Smith/Schlick-GGX G with k_direct).
 // Gltf: glTF 2.0 spec appendix B / Filament (height-correlated V instead of
 // G / (4 n.v n.l)); same D, F and diffuse.
 enum class BrdfModel { Default, Gltf };

@@ -1,5 +1,5 @@
 // The resolve stage: linear HDR radiance to the 8-bit output image, the last
-// step of conventions.md's "Output" (exposure, tone map, sRGB, rounding). It
+// step of docs/conventions.md's "Output" (exposure, tone map, sRGB, rounding). It
 // runs vectorised (eight pixels at a time with AVX2) and, as a frame's tile
 // hook (TileResolve), on every thread inside the tile pass. Byte-identical to
 // the per-pixel reference (tonemap() then linear_to_srgb8()); tested.

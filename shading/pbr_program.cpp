@@ -228,7 +228,7 @@ void PbrProgram::shade_packed(const FragmentBlock<kVaryings>* const* in, Fragmen
     shade_block_lanes<N>(mb, *ctx, rb);
 
     // Back to each block's lanes (0, 0, 0, 1 in its dead lanes). Alpha: the
-    // blend weight of BLEND materials (README "Transparency"), 1 otherwise.
+    // blend weight of BLEND materials (docs/shadows-and-transparency.md), 1 otherwise.
     const bool blend = material->m->alpha_mode == AlphaMode::Blend;
     for (int b = 0; b < count; ++b) {
         FragmentOut& o = *out[b];

@@ -1,6 +1,6 @@
 // Per-pixel shading, independent of the rasterizer: what a material is at a
 // surface point (texture lookups, normal mapping) and the light it reflects
-// (conventions.md "Shading"). The fragment program and the stepper both call
+// (docs/conventions.md "Shading"). The fragment program and the stepper both call
 // these, so an explained pixel shows the numbers that made it.
 #pragma once
 
@@ -109,7 +109,7 @@ inline float light_visibility(const ShadingLight& L, const glm::vec3& P, const g
 }
 
 // Level of detail of each bound texture, from the uv derivatives of a 2x2
-// quad (conventions.md "Textures"). The four lanes of a quad share their
+// quad (docs/conventions.md "Textures"). The four lanes of a quad share their
 // derivatives, so the fragment program computes this once per quad.
 struct MaterialLods {
     float base_color = 0, metallic_roughness = 0, roughness = 0, metallic = 0;

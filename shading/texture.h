@@ -1,7 +1,7 @@
 // Textures: the box-filtered mip chain of a decoded image (scene/image.h) and
 // the bilinear / trilinear samplers the shaders call per pixel.
 //
-// Conventions (conventions.md, "Textures"): texel centres at (i + 0.5) / width,
+// Conventions (docs/conventions.md, "Textures"): texel centres at (i + 0.5) / width,
 // v = 0 is the TOP row of the image (the project's internal UVs; no flipping
 // here), lambda = log2(max(|d(uv * size)/dx|, |d(uv * size)/dy|)) with level-0
 // sizes, as the OpenGL specification writes it (no anisotropy). Filtering and

@@ -1,5 +1,5 @@
 // Display transform: linear HDR -> tone map -> sRGB -> 8 bits, the last stage
-// of conventions.md's "Output". Exposure is NOT part of tonemap(): the caller
+// of docs/conventions.md's "Output". Exposure is NOT part of tonemap(): the caller
 // multiplies by it first (resolve_to_srgb8 does so).
 #pragma once
 

@@ -13,7 +13,6 @@
 #include "shading/tonemap.h"
 #include "stepper/format.h"
 #include "raster/samples.h"
-#include "stepper/frame_loop.h"
 
 namespace prast::stepper {
 
@@ -30,7 +29,7 @@ const char* fate_name(TriangleFate f) {
     return "?";
 }
 
-std::string mesh_name(const StepScene& s, const Recording& rec, std::uint32_t tri) {
+std::string mesh_name(const FrameSetup& s, const Recording& rec, std::uint32_t tri) {
     return s.scene.meshes[std::size_t(rec.draw_of(tri).mesh)].name;
 }
 
@@ -220,12 +219,12 @@ TileWalk walk_tile(const Recording& rec, std::uint32_t piece, int tile) {
 
 // ---------------------------------------------------------------- frame
 
-std::string frame_text(const StepScene& s, const Recording& rec) {
+std::string frame_text(const FrameSetup& s, const Recording& rec) {
     std::ostringstream o;
     const Camera& c = s.settings.camera;
     o << "frame " << rec.width << "x" << rec.height << ", tiles of " << rec.tile_size << " (" << rec.tiles_x << "x"
       << rec.tiles_y << "), " << rec.samples << " sample" << (rec.samples == 1 ? "" : "s") << " per pixel\n";
-    o << "scene " << (s.options.scene.empty() ? "built-in" : s.options.scene) << ": " << rec.triangle_count()
+    o << "scene " << (s.request.scene.empty() ? "built-in" : s.request.scene) << ": " << rec.triangle_count()
       << " triangles, " << s.scene.meshes.size() << " meshes, " << s.scene.materials.size() << " materials\n";
     o << "camera eye " << vec(c.eye) << " target " << vec(c.target) << " up " << vec(c.up) << " fov "
       << num(c.fov_y_deg) << " near " << num(c.near_plane) << " far " << num(c.far_plane) << "\n";
@@ -252,7 +251,7 @@ std::string frame_text(const StepScene& s, const Recording& rec) {
     return o.str();
 }
 
-json frame_json(const StepScene& s, const Recording& rec) {
+json frame_json(const FrameSetup& s, const Recording& rec) {
     json j;
     j["width"] = rec.width;
     j["height"] = rec.height;
@@ -269,7 +268,7 @@ json frame_json(const StepScene& s, const Recording& rec) {
 
 // ---------------------------------------------------------------- triangle
 
-std::string triangle_text(const StepScene& s, const Recording& rec, std::uint32_t tri) {
+std::string triangle_text(const FrameSetup& s, const Recording& rec, std::uint32_t tri) {
     std::ostringstream o;
     const DrawRecord& d = rec.draw_of(tri);
     const TriangleRecord& tr = rec.triangles[tri];
@@ -365,7 +364,7 @@ std::string triangle_text(const StepScene& s, const Recording& rec, std::uint32_
     return o.str();
 }
 
-json triangle_json(const StepScene& s, const Recording& rec, std::uint32_t tri) {
+json triangle_json(const FrameSetup& s, const Recording& rec, std::uint32_t tri) {
     json j;
     const TriangleRecord& tr = rec.triangles[tri];
     j["tri"] = tri;
@@ -400,7 +399,7 @@ json triangle_json(const StepScene& s, const Recording& rec, std::uint32_t tri) 
 
 // ---------------------------------------------------------------- tile
 
-std::string tile_text(const StepScene& s, const Recording& rec, int tx, int ty) {
+std::string tile_text(const FrameSetup& s, const Recording& rec, int tx, int ty) {
     std::ostringstream o;
     const int tile = ty * rec.tiles_x + tx;
     const TileRecord& t = rec.tiles[std::size_t(tile)];
@@ -432,7 +431,7 @@ std::string tile_text(const StepScene& s, const Recording& rec, int tx, int ty) 
     return o.str();
 }
 
-json tile_json(const StepScene& s, const Recording& rec, int tx, int ty) {
+json tile_json(const FrameSetup& s, const Recording& rec, int tx, int ty) {
     json j;
     const int tile = ty * rec.tiles_x + tx;
     j["tile"] = json::array({tx, ty});
@@ -458,13 +457,13 @@ glm::vec3 resolve_average(const glm::vec3* colors, int samples) {
     return out;
 }
 
-PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, int y) {
+PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x, int y) {
     PixelExplanation px;
     px.x = x;
     px.y = y;
     px.samples = rec.samples;
     const int S = rec.samples;
-    const ShadingContext ctx = shading_context(s);
+    const ShadingContext ctx = s.shading_context();
     const TileRecord& tile = rec.tiles[std::size_t(rec.tile_of(x, y))];
     const int bx = x & ~(kBlockSize - 1), by = y & ~(kBlockSize - 1);
     for (int l = 0; l < kBlockLanes; ++l)
@@ -474,7 +473,7 @@ PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, 
     // fragment in the tile's order. A draw taking the visibility pass writes
     // depth and makes the fragment the sample's winner (`pending`), shaded
     // once later; a draw shaded in order writes its colour at once.
-    px.background = frame_background(s, rec.fb.width, rec.fb.height).at(x, y);
+    px.background = s.background(rec.fb.width, rec.fb.height).at(x, y);
     for (int i = 0; i < S; ++i) {
         px.sample_depth[i] = 1.0f;
         px.sample_color[i] = px.background;
@@ -557,7 +556,7 @@ PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, 
         return __builtin_popcount(px.history[std::size_t(a)].owns) > __builtin_popcount(px.history[std::size_t(b)].owns);
     });
 
-    // The resolve (the samples' average), then conventions.md "Output".
+    // The resolve (the samples' average), then docs/conventions.md "Output".
     px.linear = resolve_average(px.sample_color, S);
     px.framebuffer = color_of(rec.fb, x, y);
     px.exposed = px.linear * s.exposure();
@@ -571,7 +570,7 @@ PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, 
 
 namespace {
 
-void shading_text(std::ostringstream& o, const StepScene& s, const Recording& rec, const HistoryEntry& h) {
+void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& rec, const HistoryEntry& h) {
     const std::uint32_t tri = rec.pieces[h.piece].triangle;
     const BoundMaterial& bm = material_of(s, rec, tri);
     const Material& m = *bm.m;
@@ -675,7 +674,7 @@ std::string entry_name(const Recording& rec, const PixelExplanation& px, int k) 
 
 } // namespace
 
-std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExplanation& px) {
+std::string pixel_text(const FrameSetup& s, const Recording& rec, const PixelExplanation& px) {
     std::ostringstream o;
     const int tile = rec.tile_of(px.x, px.y);
     const int S = px.samples;
@@ -782,7 +781,7 @@ std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExpl
     return o.str();
 }
 
-json pixel_json(const StepScene& s, const Recording& rec, const PixelExplanation& px) {
+json pixel_json(const FrameSetup& s, const Recording& rec, const PixelExplanation& px) {
     json j;
     j["x"] = px.x;
     j["y"] = px.y;

@@ -65,23 +65,23 @@ struct PixelExplanation {
     glm::vec3 exposed{0.0f}, toned{0.0f};
     std::uint8_t srgb8[3] = {0, 0, 0};
 };
-PixelExplanation explain_pixel(const StepScene& s, const Recording& rec, int x, int y);
+PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x, int y);
 
 // The resolve of raster/resolve.cpp on one pixel: pairwise sums of the
 // samples' linear colours, times 1 / samples.
 glm::vec3 resolve_average(const glm::vec3* colors, int samples);
 
-std::string frame_text(const StepScene& s, const Recording& rec);
-std::string triangle_text(const StepScene& s, const Recording& rec, std::uint32_t tri);
-std::string tile_text(const StepScene& s, const Recording& rec, int tx, int ty);
-std::string pixel_text(const StepScene& s, const Recording& rec, const PixelExplanation& px);
+std::string frame_text(const FrameSetup& s, const Recording& rec);
+std::string triangle_text(const FrameSetup& s, const Recording& rec, std::uint32_t tri);
+std::string tile_text(const FrameSetup& s, const Recording& rec, int tx, int ty);
+std::string pixel_text(const FrameSetup& s, const Recording& rec, const PixelExplanation& px);
 
-nlohmann::json frame_json(const StepScene& s, const Recording& rec);
-nlohmann::json triangle_json(const StepScene& s, const Recording& rec, std::uint32_t tri);
-nlohmann::json tile_json(const StepScene& s, const Recording& rec, int tx, int ty);
-nlohmann::json pixel_json(const StepScene& s, const Recording& rec, const PixelExplanation& px);
+nlohmann::json frame_json(const FrameSetup& s, const Recording& rec);
+nlohmann::json triangle_json(const FrameSetup& s, const Recording& rec, std::uint32_t tri);
+nlohmann::json tile_json(const FrameSetup& s, const Recording& rec, int tx, int ty);
+nlohmann::json pixel_json(const FrameSetup& s, const Recording& rec, const PixelExplanation& px);
 
 const char* fate_name(TriangleFate f);
-std::string mesh_name(const StepScene& s, const Recording& rec, std::uint32_t tri);
+std::string mesh_name(const FrameSetup& s, const Recording& rec, std::uint32_t tri);
 
 } // namespace prast::stepper

@@ -25,7 +25,7 @@ std::string html_escape(const std::string& s) {
     return out;
 }
 
-std::string export_html(StepScene& s, const Recording& rec, const std::string& dir) {
+std::string export_html(FrameSetup& s, const Recording& rec, const std::string& dir) {
     namespace fs = std::filesystem;
     std::error_code ec;
     fs::create_directories(dir, ec);

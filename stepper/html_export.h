@@ -10,7 +10,7 @@
 namespace prast::stepper {
 
 // Writes the stages and the page; returns "" or a one-line error naming the file.
-std::string export_html(StepScene& s, const Recording& rec, const std::string& dir);
+std::string export_html(FrameSetup& s, const Recording& rec, const std::string& dir);
 
 // Text with &, <, >, " escaped for HTML.
 std::string html_escape(const std::string& s);

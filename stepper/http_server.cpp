@@ -20,8 +20,8 @@ namespace {
 
 using nlohmann::json;
 
-// Limits against slow, idle and flooding clients (see the README's step
-// section): a connection must send something every kReadTimeoutSeconds, an
+// Limits against slow, idle and flooding clients (docs/security.md, "What
+// `step --serve` lets in"): a connection must send something every kReadTimeoutSeconds, an
 // idle keep-alive connection is closed after kKeepAliveSeconds, and one
 // connection serves at most kKeepAliveRequests requests.
 constexpr std::size_t kServerThreads = 16;
@@ -103,7 +103,7 @@ int serve(Session& session, int port) {
     std::mutex mutex;  // the session and the recording are used by one request at a time
     std::map<std::string, std::string> png_cache;
     const Recording& rec = session.recording();
-    StepScene& s = session.scene();
+    FrameSetup& s = session.scene();
 
     // Runs a handler under the lock, turning bad requests into 4xx JSON.
     auto guarded = [&](auto handler) {

@@ -6,7 +6,6 @@
 #include <cstring>
 #include <memory>
 
-#include "stepper/frame_loop.h"
 
 namespace prast::stepper {
 
@@ -73,7 +72,7 @@ public:
         DrawRecord d;
         d.mesh = mesh;
         d.state = st;
-        d.visible = draws_visible(st, rec_.visibility);
+        d.visible = shades_after_visibility(st, rec_.visibility);
         d.first_triangle = first;
         d.triangle_count = triangles;
         d.vertex_count = vertices;
@@ -260,7 +259,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 } // namespace
 
-void record_frame(StepScene& s, Recording& rec) {
+void record_frame(FrameSetup& s, Recording& rec) {
     rec = Recording{};
     rec.width = s.width();
     rec.height = s.height();
@@ -278,20 +277,20 @@ void record_frame(StepScene& s, Recording& rec) {
 
     RecordingObserver obs(rec);
     const auto t0 = std::chrono::steady_clock::now();
-    draw_frame(s, rec.fb, [&](int mesh, std::uint32_t first, std::uint32_t triangles, std::uint32_t vertices,
-                              const DrawState& st) { return obs.tap(mesh, first, triangles, vertices, st); });
+    s.scene_renderer->render(s.settings, rec.fb, nullptr, [&](const SceneDraw& d) {
+        return obs.tap(d.mesh, d.first_triangle, d.triangle_count, d.vertex_count, d.state);
+    });
     obs.finish();
     rec.record_ms = ms_since(t0);
     rec.stats = s.renderer->stats();
 }
 
-void draw_upto(StepScene& s, std::uint64_t triangles, Framebuffer& fb) {
+void draw_upto(FrameSetup& s, std::uint64_t triangles, Framebuffer& fb) {
     fb.resize(s.width(), s.height());
-    draw_frame(s, fb, [](int, std::uint32_t, std::uint32_t, std::uint32_t, const DrawState&) { return NullObserver{}; },
-               triangles);
+    s.scene_renderer->render(s.settings, fb, nullptr, NoTaps{}, triangles);
 }
 
-void draw_plain(StepScene& s, Framebuffer& fb) {
+void draw_plain(FrameSetup& s, Framebuffer& fb) {
     fb.resize(s.width(), s.height());
     s.scene_renderer->render(s.settings, fb);
 }

@@ -28,7 +28,7 @@
 #include "raster/setup.h"
 #include "raster/stats.h"
 #include "shading/pbr_program.h"
-#include "stepper/scene_setup.h"
+#include "renderer/frame_setup.h"
 
 namespace prast::stepper {
 
@@ -116,14 +116,14 @@ struct Recording {
     }
 };
 
-// Draws the frame with a recording observer; `rec` is filled.
-void record_frame(StepScene& s, Recording& rec);
+// Draws the frame (SceneRenderer::render, a recording tap on each draw); `rec` is filled.
+void record_frame(FrameSetup& s, Recording& rec);
 
 // The frame after the first `triangles` triangles (submission order).
-void draw_upto(StepScene& s, std::uint64_t triangles, Framebuffer& fb);
+void draw_upto(FrameSetup& s, std::uint64_t triangles, Framebuffer& fb);
 
 // The frame as `render` draws it (SceneRenderer, no observer): the cost
 // comparison and the check that the recorded frame is the same.
-void draw_plain(StepScene& s, Framebuffer& fb);
+void draw_plain(FrameSetup& s, Framebuffer& fb);
 
 } // namespace prast::stepper

@@ -7,15 +7,14 @@
 
 #include "raster/samples.h"
 #include "raster/shade.h"
-#include "stepper/frame_loop.h"
 
 namespace prast::stepper {
 
-const BoundMaterial& material_of(const StepScene& s, const Recording& rec, std::uint32_t tri) {
-    return draw_material(s, s.scene.meshes[std::size_t(rec.draw_of(tri).mesh)]);
+const BoundMaterial& material_of(const FrameSetup& s, const Recording& rec, std::uint32_t tri) {
+    return s.scene_renderer->material_of(s.scene.meshes[std::size_t(rec.draw_of(tri).mesh)]);
 }
 
-ClipReplay replay_clip(const StepScene& s, const Recording& rec, std::uint32_t tri) {
+ClipReplay replay_clip(const FrameSetup& s, const Recording& rec, std::uint32_t tri) {
     ClipReplay c;
     const DrawRecord& d = rec.draw_of(tri);
     const Mesh& mesh = s.scene.meshes[std::size_t(d.mesh)];
@@ -43,7 +42,7 @@ ClipReplay replay_clip(const StepScene& s, const Recording& rec, std::uint32_t t
     return c;
 }
 
-void piece_vertices(const StepScene& s, const Recording& rec, std::uint32_t piece, float out[3][kStride]) {
+void piece_vertices(const FrameSetup& s, const Recording& rec, std::uint32_t piece, float out[3][kStride]) {
     const PieceRecord& p = rec.pieces[piece];
     const TriangleSetup& t = rec.setups[p.setup];
     const DrawRecord& d = rec.draw_of(p.triangle);
@@ -76,7 +75,7 @@ SnappedVertex snap_vertex(const float* clip, int width, int height) {
     return v;
 }
 
-void replay_block(const StepScene& s, const Recording& rec, const BlockRecord& b, ReplayedBlock& out) {
+void replay_block(const FrameSetup& s, const Recording& rec, const BlockRecord& b, ReplayedBlock& out) {
     const PieceRecord& p = rec.pieces[b.piece];
     const TriangleSetup& t = rec.setups[p.setup];
     float v[3][kStride];

@@ -29,10 +29,10 @@ struct ClipReplay {
     int count = 0;                      // polygon vertices after clipping (3 when not clipped)
     float polygon[kMaxClippedVertices][kStride] = {};
 };
-ClipReplay replay_clip(const StepScene& s, const Recording& rec, std::uint32_t tri);
+ClipReplay replay_clip(const FrameSetup& s, const Recording& rec, std::uint32_t tri);
 
 // The three vertices of a set-up piece in TriangleSetup order (vtx[0..2]).
-void piece_vertices(const StepScene& s, const Recording& rec, std::uint32_t piece, float out[3][kStride]);
+void piece_vertices(const FrameSetup& s, const Recording& rec, std::uint32_t piece, float out[3][kStride]);
 
 // Window position of a vertex, snapped to 1/256 pixel as setup_triangle() does.
 struct SnappedVertex {
@@ -54,7 +54,7 @@ struct ReplayedBlock {
     float at_x[kBlockLanes], at_y[kBlockLanes];  // the point, in pixels from the pixel centre
     std::uint8_t centroid_of[kBlockLanes];       // bit s: sample s in the centroid; 0: the centre
 };
-void replay_block(const StepScene& s, const Recording& rec, const BlockRecord& b, ReplayedBlock& out);
+void replay_block(const FrameSetup& s, const Recording& rec, const BlockRecord& b, ReplayedBlock& out);
 
 // One lane's shading, step by step, as shade_surface() computes it.
 struct LightStep {
@@ -80,6 +80,6 @@ struct LaneShading {
 LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const ReplayedBlock& rb, int lane);
 
 // The material a triangle's draw uses.
-const BoundMaterial& material_of(const StepScene& s, const Recording& rec, std::uint32_t tri);
+const BoundMaterial& material_of(const FrameSetup& s, const Recording& rec, std::uint32_t tri);
 
 } // namespace prast::stepper

@@ -13,7 +13,6 @@
 #include "shading/tonemap.h"
 #include "stepper/explain.h"
 #include "stepper/format.h"
-#include "stepper/frame_loop.h"
 #include "stepper/replay.h"
 #include "stepper/stages.h"
 
@@ -59,8 +58,8 @@ std::string count_range(long n) { return n > 0 ? "0.." + std::to_string(n - 1) :
 // same order, and the values the stepper recomputes equal to the pipeline's.
 class VerifyObserver {
 public:
-    VerifyObserver(const StepScene& s, const Recording& rec)
-        : s_(s), rec_(rec), ctx_(shading_context(s)), cursor_(rec.tiles.size(), 0) {}
+    VerifyObserver(const FrameSetup& s, const Recording& rec)
+        : s_(s), rec_(rec), ctx_(s.shading_context()), cursor_(rec.tiles.size(), 0) {}
 
     // The observer of one draw.
     struct Tap {
@@ -161,7 +160,7 @@ public:
         if (failures_++ == 0) first_ = what;
     }
 
-    const StepScene& s_;
+    const FrameSetup& s_;
     const Recording& rec_;
     const ShadingContext ctx_;
     std::vector<std::size_t> cursor_;
@@ -309,7 +308,7 @@ std::vector<std::uint8_t> Session::upto_png(std::uint64_t triangles) {
 Reply Session::verify() {
     VerifyObserver obs(s_, rec_);
     Framebuffer fb(rec_.width, rec_.height);
-    draw_frame(s_, fb, [&](int, std::uint32_t, std::uint32_t, std::uint32_t, const DrawState&) { return obs.tap(); });
+    s_.scene_renderer->render(s_.settings, fb, nullptr, [&](const SceneDraw&) { return obs.tap(); });
     for (std::size_t t = 0; t < rec_.tiles.size(); ++t)
         if (obs.cursor_[t] != rec_.tiles[t].blocks.size()) obs.fail("tile " + std::to_string(t) + " has fewer blocks");
     if (std::memcmp(fb.color.data(), rec_.fb.color.data(), fb.color.size() * sizeof(float)) ||

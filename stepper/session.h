@@ -20,7 +20,7 @@ struct Reply {
 
 class Session {
 public:
-    Session(StepScene& scene, Recording& rec) : s_(scene), rec_(rec) {}
+    Session(FrameSetup& scene, Recording& rec) : s_(scene), rec_(rec) {}
 
     Reply run(const std::string& line);
 
@@ -29,7 +29,7 @@ public:
     std::vector<std::uint8_t> upto_png(std::uint64_t triangles);
     std::vector<std::uint8_t> upto_rgba(std::uint64_t triangles);
 
-    StepScene& scene() { return s_; }
+    FrameSetup& scene() { return s_; }
     const Recording& recording() const { return rec_; }
 
 private:
@@ -37,7 +37,7 @@ private:
     Reply cost();
     Reply verify();
 
-    StepScene& s_;
+    FrameSetup& s_;
     Recording& rec_;
 };
 

@@ -10,7 +10,6 @@
 
 #include "shading/color.h"
 #include "shading/tonemap.h"
-#include "stepper/frame_loop.h"
 #include "stepper/replay.h"
 
 namespace prast::stepper {
@@ -156,7 +155,7 @@ void draw_vertices(const Recording& rec, Image& img) {
         }
 }
 
-void draw_wireframe(const StepScene& s, const Recording& rec, Image& img) {
+void draw_wireframe(const FrameSetup& s, const Recording& rec, Image& img) {
     fill(img, rec, 0);
     const glm::vec3 kSetUp(1.0f), kClipped(1.0f, 0.55f, 0.1f), kBack(0.15f, 0.2f, 0.6f), kDegenerate(1.0f, 0.0f, 1.0f);
     auto triangle = [&](const float* a, const float* b, const float* c, glm::vec3 col) {
@@ -206,7 +205,7 @@ void draw_bins(const Recording& rec, Image& img) {
         }
 }
 
-void draw_depth(const StepScene& s, const Recording& rec, Image& img) {
+void draw_depth(const FrameSetup& s, const Recording& rec, Image& img) {
     fill(img, rec, 0);
     const float n = s.settings.camera.near_plane, f = s.settings.camera.far_plane;
     for (int y = 0; y < rec.height; ++y)
@@ -374,7 +373,7 @@ void draw_nan(const Recording& rec, Image& img) {
         }
 }
 
-void draw_final(const StepScene& s, const Recording& rec, Image& img) {
+void draw_final(const FrameSetup& s, const Recording& rec, Image& img) {
     img.resize(std::size_t(rec.width) * rec.height * 4);
     resolve_to_srgb8(rec.fb.color.data(), rec.width, rec.height, s.exposure(), s.tonemap(), img.data());
 }
@@ -399,7 +398,7 @@ glm::vec3 mip_colour(float lambda) {
     return glm::mix(kLevels[i], kLevels[i + 1], l - float(i));
 }
 
-glm::vec3 surface_value(const std::string& n, const StepScene& s, const BoundMaterial& bm, const LaneShading& sh) {
+glm::vec3 surface_value(const std::string& n, const FrameSetup& s, const BoundMaterial& bm, const LaneShading& sh) {
     const MaterialSample& ms = sh.ms;
     if (n == "albedo") return srgb(ms.albedo);
     if (n == "normal") return ms.N * 0.5f + 0.5f;
@@ -430,7 +429,7 @@ glm::vec3 surface_value(const std::string& n, const StepScene& s, const BoundMat
 
 } // namespace
 
-void draw_stages(StepScene& s, const Recording& rec, const std::vector<std::string>& names,
+void draw_stages(FrameSetup& s, const Recording& rec, const std::vector<std::string>& names,
                  std::vector<std::vector<std::uint8_t>>& images) {
     images.assign(names.size(), {});
     std::vector<std::size_t> surface;
@@ -456,7 +455,7 @@ void draw_stages(StepScene& s, const Recording& rec, const std::vector<std::stri
     if (surface.empty()) return;
     // Shade every pixel's winning fragment again, a tile per task: each
     // block that wins a pixel is replayed once, each winning lane shaded.
-    const ShadingContext ctx = shading_context(s);
+    const ShadingContext ctx = s.shading_context();
     s.renderer->pool().run(int(rec.tiles.size()), [&](int tile, int) {
         const TileRecord& t = rec.tiles[std::size_t(tile)];
         const int ts = rec.tile_size;
@@ -490,7 +489,7 @@ void draw_stages(StepScene& s, const Recording& rec, const std::vector<std::stri
     });
 }
 
-void draw_stage(StepScene& s, const Recording& rec, const std::string& name, std::vector<std::uint8_t>& rgba8) {
+void draw_stage(FrameSetup& s, const Recording& rec, const std::string& name, std::vector<std::uint8_t>& rgba8) {
     std::vector<Image> images;
     draw_stages(s, rec, {name}, images);
     rgba8 = std::move(images[0]);

@@ -20,11 +20,11 @@ const std::vector<StageInfo>& stage_list();
 const StageInfo* find_stage(const std::string& name);
 
 // Draws stage `name` (a name from stage_list()) into rgba8 (width * height * 4).
-void draw_stage(StepScene& s, const Recording& rec, const std::string& name, std::vector<std::uint8_t>& rgba8);
+void draw_stage(FrameSetup& s, const Recording& rec, const std::string& name, std::vector<std::uint8_t>& rgba8);
 
 // Several surface stages (material channels and BRDF terms) need the same
 // per-pixel shading: draws all of `names` in one pass over the pixels.
-void draw_stages(StepScene& s, const Recording& rec, const std::vector<std::string>& names,
+void draw_stages(FrameSetup& s, const Recording& rec, const std::vector<std::string>& names,
                  std::vector<std::vector<std::uint8_t>>& images);
 
 } // namespace prast::stepper

@@ -140,7 +140,7 @@ TEST_CASE("assets/textured-sphere: one UV sphere, its maps, and tangents that ag
         CHECK(img.height == 64);
     }
     // The file's tangents are the ones the project would compute from the UVs
-    // (conventions.md, "Normal mapping": T along +u, cross(N, T) w up the
+    // (docs/conventions.md, "Normal mapping": T along +u, cross(N, T) w up the
     // image), away from the poles where dP/du vanishes.
     Mesh computed = m;
     computed.tangents.clear();
@@ -170,7 +170,7 @@ TEST_CASE("assets/env/studio_small.hdr: 128x64, the key light front left and up,
         for (int x = 0; x < env.width; ++x) {
             const glm::vec4 c = env.at(x, y);
             if (c.r + c.g + c.b <= 40.0f) continue;
-            // Its direction (conventions.md, "Environment maps"): u = 0.5 + atan2(x, -z) / 2 pi,
+            // Its direction (docs/conventions.md, "Environment maps"): u = 0.5 + atan2(x, -z) / 2 pi,
             // v = acos(y) / pi.
             const double u = (x + 0.5) / env.width, v = (y + 0.5) / env.height;
             const double phi = (u - 0.5) * 2.0 * M_PI, theta = v * M_PI;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli/bench_flags.h"
 #include "tests/cli_util.h"
 
 using namespace prast::cli_test;
@@ -60,6 +61,11 @@ TEST_CASE("bench: writes its workloads and measures them, in text, JSON, alterna
     for (const std::string& line : lines_of(read_text(fs::path(dir) / "commands.txt")))
         if (line.rfind("grid: render ", 0) == 0) grid_command = line.substr(std::string("grid: render ").size());
     REQUIRE(!grid_command.empty());
+    // One line per workload --workload accepts, in its order.
+    std::vector<std::string> listed;
+    for (const std::string& line : lines_of(read_text(fs::path(dir) / "commands.txt")))
+        listed.push_back(line.substr(0, line.find(':')));
+    CHECK(listed == prast::cli::bench_workload_names());
     CHECK(grid_command.find("'--size' '1920x1080'") != std::string::npos);
     CliRun g = box.run_exe("sh", {"-c", shell_quote(PRAST_RENDER_EXE) + " " + grid_command + " --msaa 1 -o grid.png"});
     CHECK(g.code == 0);
@@ -128,10 +134,13 @@ TEST_CASE("bench: PSNR of two images, and bad arguments are one line and a non-z
     const Bad bad[] = {
         {{"--psnr", "a.png", "c.png"}, 1, "differ in size"},
         {{"--psnr", "a.png", "missing.png"}, 1, "missing.png"},
-        {{"--workload", "nosuch"}, 2, "unknown workload 'nosuch'"},
-        {{"--msaa", "3"}, 2, "usage: bench"},
-        {{"--size", "0x10", "--flat"}, 2, "usage: bench"},
-        {{"--bogus"}, 2, "usage: bench"},
+        {{"--workload", "nosuch"}, 2, "bench: --workload 'nosuch': unknown workload 'nosuch'"},
+        {{"--msaa", "3"}, 2, "bench: --msaa '3': expected a comma list of 1, 2, 4 or 8"},
+        {{"--size", "0x10", "--flat"}, 2, "bench: --size '0x10'"},
+        {{"--repeat", "x"}, 2, "bench: --repeat 'x'"},
+        {{"--psnr", "a.png"}, 2, "bench: --psnr: missing value"},
+        {{"--bogus"}, 2, "bench: unknown option '--bogus'"},
+        {{"--thread", "1"}, 2, "(did you mean --threads?)"},
     };
     for (const Bad& b : bad) {
         CAPTURE(b.args[0]);
@@ -139,7 +148,7 @@ TEST_CASE("bench: PSNR of two images, and bad arguments are one line and a non-z
         CliRun r = box.run_exe(PRAST_BENCH_EXE, b.args);
         CHECK(r.code == b.code);
         CHECK(r.err.find(b.says) != std::string::npos);
-        if (b.code == 1) CHECK(lines_of(r.err).size() == 1);
+        CHECK(lines_of(r.err).size() == 1);
         CHECK(r.out.empty());
     }
     // Nothing was written but the three images.

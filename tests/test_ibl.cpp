@@ -257,7 +257,7 @@ TEST_CASE("white furnace: split sum and reference under a uniform sky of radianc
             // The plain model, measured: a white metal keeps only its single
             // scattering (down to 0.31 at r = 1 with k = r^2 / 2); a white
             // dielectric stays within 1 near normal incidence and overshoots at
-            // grazing views (the conventions' kd, README "Deviations").
+            // grazing views (the conventions' kd, docs/deviations.md).
             if (metallic == 1.0f) {
                 CHECK(max_plain <= 1.0 + 2e-4);
                 CHECK(min_plain >= 0.30);

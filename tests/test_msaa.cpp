@@ -1,4 +1,4 @@
-// Multisampling (conventions.md, "Multisampling and blending"): the standard
+// Multisampling (docs/conventions.md, "Multisampling and blending"): the standard
 // sample positions; coverage along a long straight edge against the exact
 // covered area; pixels fully inside a triangle identical to the 1-sample
 // image; a watertight mesh covering every sample exactly once (watched
@@ -162,7 +162,7 @@ Framebuffer render_grid(const GridMesh& g, int W, int H, int samples, int thread
 TEST_SUITE("msaa") {
 
 TEST_CASE("msaa: the standard sample positions, inside the pixel, distinct, on the 1/16 grid") {
-    // conventions.md gives the 4x positions within the pixel.
+    // docs/conventions.md gives the 4x positions within the pixel.
     const SamplePattern& four = sample_pattern(4);
     const double expect[4][2] = {{0.375, 0.125}, {0.875, 0.375}, {0.125, 0.625}, {0.625, 0.875}};
     for (int s = 0; s < 4; ++s) {

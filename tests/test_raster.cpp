@@ -1,4 +1,4 @@
-// The raster pipeline against the conventions (../shared/spec/conventions.md:
+// The raster pipeline against the conventions (docs/conventions.md:
 // "Spaces and cameras", "Coverage", "Interpolation"): watertightness, the
 // top-left fill rule, perspective-correct varyings, clipping, depth, thread and
 // tile invariance, a golden image, the observer hooks and the frame counters.

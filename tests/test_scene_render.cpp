@@ -1,8 +1,11 @@
 // The whole shading path on whole scenes: the built-in scene against its
-// golden image, thread/tile invariance of PBR frames, and the real assets of
-// ../shared/assets rendered without NaN.
+// golden image, thread/tile invariance of PBR frames, the real assets of
+// ../shared/assets rendered without NaN, the one frame set-up
+// (renderer/frame_setup.h) that render and step share, and SceneRenderer's
+// per-draw taps and triangle limit (what step records through).
 #include <doctest/doctest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -10,6 +13,9 @@
 #include <vector>
 
 
+#include "apps/frame_request.h"
+#include "apps/render_options.h"
+#include "renderer/frame_setup.h"
 #include "scene/default_scene.h"
 #include "scene/image_diff.h"
 #include "scene/write_image.h"
@@ -210,4 +216,187 @@ TEST_CASE("a double-sided material shades its back face with the normal flipped"
     Framebuffer culled = render_quad(quad_scene(m), {0, 0, -3}, {0, 0, -1});
     CHECK(culled.depth[16 * 32 + 16] == 1.0f);
 }
+}
+
+namespace {
+
+RenderOptions parse_flags(std::vector<std::string> args) {
+    std::vector<const char*> argv = {"render"};
+    for (const std::string& a : args) argv.push_back(a.c_str());
+    RenderOptions opt;
+    const std::string err = parse_render_args(int(argv.size()), argv.data(), opt);
+    REQUIRE_MESSAGE(err.empty(), err);
+    return opt;
+}
+
+// A tap that counts what one draw reports.
+struct CountingTap {
+    static constexpr bool enabled = true;
+    std::atomic<std::uint64_t>* vertices;
+    std::atomic<std::uint64_t>* triangles;
+    void vertex(std::uint32_t, const float*, const float*, int) { ++*vertices; }
+    void triangle(std::uint32_t, TriangleFate, bool, const TriangleSetup*) { ++*triangles; }
+    void binned(std::uint32_t, int) {}
+    void fragments(std::uint32_t, int, int, std::uint32_t, std::uint32_t, const float*) {}
+    template <int NV>
+    void shaded(const FragmentBlock<NV>&, const FragmentOut&, std::uint32_t) {}
+};
+
+} // namespace
+
+TEST_SUITE("scene") {
+
+TEST_CASE("frame set-up: render's and step's requests for the same flags give the same frame") {
+    const std::string env = std::string(PRAST_SOURCE_DIR) + "/assets/env/studio_small.hdr";
+    const std::string cornell = std::string(PRAST_SOURCE_DIR) + "/assets/cornell/cornell.obj";
+    const std::vector<std::vector<std::string>> command_lines = {
+        {"--size", "96x64"},
+        {"--size", "96x64", "--msaa", "1", "--shadows", "on", "--shadow-size", "256", "--sun", "1,2,3:2,2,2"},
+        {cornell, "--size", "80x60", "--eye", "0,1,4", "--fov", "50", "--near", "0.5", "--brdf", "gltf"},
+        {cornell, "--size", "80x60", "--env", env, "--env-intensity", "2", "--energy", "conserve",
+         "--background", "blur", "--ambient", "0.2,0.2,0.2"},
+    };
+    for (const std::vector<std::string>& args : command_lines) {
+        INFO(args.front() << " ... " << args.back());
+        const RenderOptions opt = parse_flags(args);
+        const FrameRequest render_req = render_frame_request(opt), step_req = step_frame_request(opt);
+        CHECK(step_req.recording);
+        CHECK(!render_req.recording);
+        FrameSetup r, s;
+        REQUIRE(!prepare_scene(render_req, r));
+        REQUIRE(!prepare_scene(step_req, s));
+        REQUIRE(!r.orbit(0.0));
+        REQUIRE(!s.orbit(0.0));
+        const FrameSettings &a = r.settings, &b = s.settings;
+        const Camera &ca = a.camera, &cb = b.camera;
+        CHECK(ca.eye == cb.eye);
+        CHECK(ca.target == cb.target);
+        CHECK(ca.up == cb.up);
+        CHECK(ca.fov_y_deg == cb.fov_y_deg);
+        CHECK(ca.near_plane == cb.near_plane);
+        CHECK(ca.far_plane == cb.far_plane);
+        REQUIRE(a.lights.size() == b.lights.size());
+        for (std::size_t i = 0; i < a.lights.size(); ++i) {
+            CHECK(a.lights[i].point == b.lights[i].point);
+            CHECK(a.lights[i].direction == b.lights[i].direction);
+            CHECK(a.lights[i].position == b.lights[i].position);
+            CHECK(a.lights[i].radiance == b.lights[i].radiance);
+        }
+        CHECK(a.ambient == b.ambient);
+        CHECK(a.model == b.model);
+        CHECK(a.view == b.view);
+        CHECK(a.energy == b.energy);
+        CHECK(a.background == b.background);
+        CHECK(a.background_color == b.background_color);
+        CHECK(a.samples == b.samples);
+        CHECK(a.samples == opt.msaa);
+        CHECK(a.shadows.enabled == b.shadows.enabled);
+        CHECK(a.shadows.size == b.shadows.size);
+        CHECK(r.exposure() == s.exposure());
+        CHECK(r.tonemap() == s.tonemap());
+        CHECK(bool(r.environment_image) == bool(s.environment_image));
+        CHECK(r.used_default_rig == s.used_default_rig);
+        CHECK(r.notes == s.notes);
+    }
+}
+
+TEST_CASE("frame set-up: the default rig, the notes and the errors with their exit codes") {
+    const std::string cornell = std::string(PRAST_SOURCE_DIR) + "/assets/cornell/cornell.obj";
+    const std::string env = std::string(PRAST_SOURCE_DIR) + "/assets/env/studio_small.hdr";
+    {
+        // No light in the model or the flags, no environment: the rig, said so.
+        FrameSetup f;
+        REQUIRE(!prepare_scene(render_frame_request(parse_flags({cornell, "--size", "64x48"})), f));
+        CHECK(f.used_default_rig);
+        CHECK(f.settings.lights.size() == default_light_rig().size());
+        REQUIRE(f.notes.size() == 1);
+        CHECK(f.notes[0].find("using the default key+fill rig") != std::string::npos);
+    }
+    {
+        // An environment lights the scene: no rig, and --ambient is said to be unused.
+        FrameSetup f;
+        REQUIRE(!prepare_scene(render_frame_request(parse_flags({cornell, "--size", "64x48", "--env", env,
+                                                                 "--ambient", "0.5,0.5,0.5"})), f));
+        CHECK(!f.used_default_rig);
+        CHECK(f.settings.lights.empty());
+        REQUIRE(f.notes.size() == 1);
+        CHECK(f.notes[0] == "warning: --ambient is not used: the environment map replaces the ambient term");
+    }
+    FrameRequest req = render_frame_request(parse_flags({"--size", "64x48"}));
+    req.scene = std::string(PRAST_SOURCE_DIR) + "/assets/no-such-model.obj";
+    FrameSetup missing;
+    const FrameError e1 = prepare_scene(req, missing);
+    CHECK(e1.code == kFrameExitBadFile);
+    CHECK(e1.message.find("no-such-model.obj") != std::string::npos);
+    req = render_frame_request(parse_flags({"--size", "64x48", "--eye", "1,1,1", "--target", "1,1,1"}));
+    FrameSetup same_point;
+    const FrameError e2 = prepare_scene(req, same_point);
+    CHECK(e2.code == kFrameExitUsage);
+    CHECK(e2.message == "--eye/--target: the eye and the target are the same point");
+    req = render_frame_request(parse_flags({cornell, "--env", "/nonexistent/sky.hdr"}));
+    FrameSetup no_env;
+    const FrameError e3 = prepare_scene(req, no_env);
+    CHECK(e3.code == kFrameExitBadFile);
+    CHECK(e3.message.find("sky.hdr") != std::string::npos);
+}
+
+TEST_CASE("SceneRenderer: taps see every draw, change no byte, and a triangle limit stops the frame there") {
+    FrameSetup f;
+    REQUIRE(!setup_frame(render_frame_request(parse_flags({"--size", "96x64", "--threads", "2"})), f));
+    REQUIRE(!f.orbit(0.0));
+    SceneRenderer& sr = *f.scene_renderer;
+    Framebuffer plain(96, 64), tapped(96, 64);
+    sr.render(f.settings, plain);
+
+    std::atomic<std::uint64_t> vertices{0}, triangles{0};
+    std::vector<SceneDraw> draws;
+    sr.render(f.settings, tapped, nullptr, [&](const SceneDraw& d) {
+        draws.push_back(d);
+        return CountingTap{&vertices, &triangles};
+    });
+    CHECK(tapped.color == plain.color);
+    CHECK(tapped.depth == plain.depth);
+    std::uint64_t total_vertices = 0, total_triangles = 0;
+    REQUIRE(!draws.empty());
+    for (const SceneDraw& d : draws) {
+        const Mesh& m = f.scene.meshes[std::size_t(d.mesh)];
+        CHECK(d.first_triangle == total_triangles);  // numbered in submission order
+        CHECK(d.triangle_count == m.indices.size() / 3);
+        CHECK(d.vertex_count == m.positions.size());
+        total_vertices += d.vertex_count;
+        total_triangles += d.triangle_count;
+    }
+    CHECK(total_triangles == f.scene.triangle_count());
+    CHECK(vertices.load() == total_vertices);
+    CHECK(triangles.load() >= total_triangles);  // one event per triangle, one per clipped piece
+
+    // A limit inside the second draw: no tap for the draws after it, and
+    // only the triangles before the limit reported.
+    REQUIRE(draws.size() >= 2);
+    const std::uint64_t limit = draws[1].first_triangle + 1;
+    std::size_t taps = 0;
+    std::atomic<std::uint64_t> v2{0}, t2{0};
+    Framebuffer cut(96, 64);
+    sr.render(f.settings, cut, nullptr, [&](const SceneDraw&) {
+        ++taps;
+        return CountingTap{&v2, &t2};
+    }, limit);
+    CHECK(taps == 2);
+    CHECK(t2.load() >= limit);
+    CHECK(t2.load() < triangles.load());
+    // No triangle at all: every sample is the background.
+    Framebuffer none(96, 64), background(96, 64);
+    sr.render(f.settings, none, nullptr, NoTaps{}, 0);
+    const BackgroundFill fill = f.background(96, 64);
+    bool all_background = true;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 96; ++x) {
+            const glm::vec3 c = fill.at(x, y);
+            const float* p = none.pixel(x, y);
+            all_background &= p[0] == c.r && p[1] == c.g && p[2] == c.b;
+        }
+    CHECK(all_background);
+    CHECK(cut.color != plain.color);
+}
+
 }

@@ -1,4 +1,4 @@
-// Shadow maps (README "Shadows"): the outline of a square occluder's shadow
+// Shadow maps (docs/shadows-and-transparency.md): the outline of a square occluder's shadow
 // against its exact projection, no acne on a lit plane, no light leaking at
 // a contact, a point light's cube map, determinism across threads and tiles.
 // Images use the diffuse debug view (Lambert only, no tone map): a lit plane

@@ -381,7 +381,7 @@ TEST_CASE("sessions: bad commands get one line each and the session goes on") {
 TEST_CASE("flags: step takes every flag of render's --help, or refuses it") {
     // A render flag step neither lists nor refuses would be parsed and then
     // ignored, and step would explain a frame render does not draw: a new
-    // flag must reach FrameRequest (stepper/scene_setup.h) and step's --help,
+    // flag must reach FrameRequest (apps/frame_request.h) and step's --help,
     // or join kNotForStep in apps/step.cpp.
     auto flags = [](const std::string& help) {
         std::vector<std::string> out;

@@ -1,4 +1,4 @@
-// Alpha BLEND (README "Transparency"): the exact blended value over a known
+// Alpha BLEND (docs/shadows-and-transparency.md): the exact blended value over a known
 // background (with 1 and 4 samples), back-to-front order whatever the file
 // order, opaque output unchanged by blended meshes, and the sort itself.
 #include <doctest/doctest.h>

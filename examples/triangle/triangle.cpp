@@ -1,4 +1,4 @@
-// The README's MyProgram made real: a custom vertex + fragment program drawn
+// docs/pipeline.md's program made real: a custom vertex + fragment program drawn
 // with prast's pipeline, written as a PNG. Only the installed headers and
 // libraries are used (prast::raster for the pipeline, prast::scene for the PNG
 // writer).

@@ -1,4 +1,4 @@
-// What the image shows where no triangle was drawn (conventions.md "Output"):
+// What the image shows where no triangle was drawn (docs/conventions.md "Output"):
 // black, unless an environment map is shown (the map itself, or its
 // prefiltered level of a medium roughness, `--background blur`), or a flat
 // colour the user asked for. A frame clears each pixel to it (in the tile

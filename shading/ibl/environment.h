@@ -1,4 +1,4 @@
-// An environment map made ready for image-based lighting (conventions.md
+// An environment map made ready for image-based lighting (docs/conventions.md
 // "Environment maps", "Shading"): from an equirect radiance image, times
 // --env-intensity and turned about +Y by --env-rotate, it precomputes
 //   - the source's mip chain (area- and solid-angle-weighted), which the
@@ -16,7 +16,7 @@
 //
 // Precomputation runs on the renderer's thread pool, one task per output row,
 // with fixed-order sums: the same bytes for any thread count. It is fast
-// enough not to need a cache (README "Image-based lighting" gives the times).
+// enough not to need a cache (docs/ibl.md gives the times).
 #pragma once
 
 #include <cstdint>
@@ -38,7 +38,7 @@ struct EnvironmentSettings {
     bool importance_sampling = false;  // build the sampler (--ibl reference)
 };
 
-// Milliseconds per precomputation stage (render --stats, the README).
+// Milliseconds per precomputation stage (render --stats, docs/ibl.md).
 struct EnvironmentTimings {
     double mips = 0, sh = 0, prefilter = 0, sampler = 0;
 };

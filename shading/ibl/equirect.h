@@ -1,4 +1,4 @@
-// The equirectangular (latitude-longitude) mapping of conventions.md
+// The equirectangular (latitude-longitude) mapping of docs/conventions.md
 // "Environment maps": a world direction d = (x, y, z) maps to
 // u = 0.5 + atan2(x, -z) / (2 pi), v = acos(y) / pi (row 0 looks up +Y, the
 // centre column looks down -Z, u grows towards +X), and bilinear filtering of

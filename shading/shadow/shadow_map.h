@@ -1,5 +1,4 @@
-// A light's shadow map and how a surface point reads it (README "Shadows and
-// transparency"). The map stores, per texel, the distance from the light to
+// A light's shadow map and how a surface point reads it (docs/shadows-and-transparency.md). The map stores, per texel, the distance from the light to
 // the nearest caster: along the light's direction from the map's near plane
 // (directional lights, one orthographic map) or from the light's position
 // (point lights, a cube of six 90-degree perspective faces). shadow_pass.h

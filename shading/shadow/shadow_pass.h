@@ -1,4 +1,4 @@
-// The shadow maps of a frame (README "Shadows and transparency"): for each
+// The shadow maps of a frame (docs/shadows-and-transparency.md): for each
 // light, the scene drawn by the pipeline into a depth target from the
 // light's view, then turned into distances (shadow_map.h).
 //

@@ -47,11 +47,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "apps/cli/bench_flags.h"
+#include "apps/frame_request.h"
 #include "scene/default_scene.h"
 #include "scene/encode_png.h"
 #include "scene/image.h"
+#include "scene/image_diff.h"
 #include "scene/load_scene.h"
 #include "scene/messages.h"
+#include "scene/procedural_images.h"
 #include "shading/output8.h"
 #include "renderer/scene_renderer.h"
 #include "shading/tonemap.h"
@@ -63,22 +67,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-std::vector<int> parse_list(const std::string& s) {
-    std::vector<int> out;
-    std::stringstream ss(s);
-    std::string item;
-    while (std::getline(ss, item, ',')) out.push_back(std::atoi(item.c_str()));
-    return out;
-}
-
-std::vector<std::string> split(const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream ss(s);
-    std::string item;
-    while (std::getline(ss, item, ',')) out.push_back(item);
-    return out;
-}
 
 struct Summary {
     double min = 0, median = 0, max = 0;
@@ -94,25 +82,12 @@ Summary summarise(std::vector<double> v) {
     return s;
 }
 
-// ---- Deterministic content for the synthetic maps.
+// ---- Deterministic content for the synthetic maps: scene/procedural_images'
+// value noise on its Linear lattice.
 
-std::uint32_t hash_u32(std::uint32_t x) {
-    x ^= x >> 16; x *= 0x7FEB352DU; x ^= x >> 15; x *= 0x846CA68BU; x ^= x >> 16;
-    return x;
-}
-float hash_unit(int x, int y, std::uint32_t seed) {
-    return float(hash_u32(std::uint32_t(x) * 73856093U ^ std::uint32_t(y) * 19349663U ^ seed) >> 8) / 16777216.0f;
-}
-// Value noise with period `cells` (tiles seamlessly), in [0, 1].
+float hash_unit(int x, int y, std::uint32_t seed) { return lattice_value(x, y, seed, NoiseLattice::Linear); }
 float value_noise(float u, float v, int cells, std::uint32_t seed) {
-    const float x = u * float(cells), y = v * float(cells);
-    const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
-    const float fx = x - float(x0), fy = y - float(y0);
-    const float sx = fx * fx * (3 - 2 * fx), sy = fy * fy * (3 - 2 * fy);
-    auto h = [&](int i, int j) { return hash_unit(((i % cells) + cells) % cells, ((j % cells) + cells) % cells, seed); };
-    const float a = h(x0, y0) + (h(x0 + 1, y0) - h(x0, y0)) * sx;
-    const float b = h(x0, y0 + 1) + (h(x0 + 1, y0 + 1) - h(x0, y0 + 1)) * sx;
-    return a + (b - a) * sy;
+    return prast::value_noise(glm::vec2(u, v), cells, seed, NoiseLattice::Linear);
 }
 float fbm(float u, float v, std::uint32_t seed) {
     return 0.5f * value_noise(u, v, 8, seed) + 0.3f * value_noise(u, v, 32, seed + 1) +
@@ -390,48 +365,30 @@ struct Result {
 };
 
 // bench --shadows / --shadow-size / --blend.
-struct FeatureOptions {
-    std::vector<bool> shadows{false};  // each configuration is measured once per entry
-    int shadow_size = ShadowSettings{}.size;
-    float blend_alpha = -1.0f;         // >= 0: every material BLEND with this alpha
-};
+using FeatureOptions = cli::BenchOptions;
 
-// A workload's scene (loaded, or the built-in one) and the frame settings
-// every measurement uses: its camera with fitted clip planes, its own lights
-// or one sun, ambient 0.05.
+// A workload's frame: render's own frame set-up (renderer/frame_setup.h) for
+// the workload's render flags (render_args), so that every measurement draws
+// the frame `render` draws for them: its camera with fitted clip planes, its
+// lights and one sun, ambient 0.05.
 struct LoadedWorkload {
-    DefaultScene builtin;
-    Scene loaded;
+    FrameSetup frame;
     const Scene* scene = nullptr;
     FrameSettings settings;
 };
 
 void load_workload(const Workload& w, int samples, LoadedWorkload& out) {
-    Camera cam;
-    if (w.file.empty()) {
-        out.builtin = make_default_scene();
-        out.scene = &out.builtin.scene;
-        cam = out.builtin.camera;
-    } else {
-        out.loaded = load_scene(w.file);
-        out.scene = &out.loaded;
-        cam.eye = w.eye;
-        cam.target = w.target;
-        cam.fov_y_deg = w.fov;
-    }
-    fit_clip_planes(cam, out.scene->bounds());
-    FrameSettings& fs = out.settings;
-    fs.camera = cam;
-    if (w.own_lights) {
-        fs.lights = shading_lights(*out.scene);
-    } else {
-        ShadingLight sun;
-        sun.direction = glm::normalize(glm::vec3(0.35f, 0.6f, 0.7f));
-        sun.radiance = glm::vec3(3.0f);
-        fs.lights = {sun};
-    }
-    fs.ambient = glm::vec3(0.05f);
-    fs.samples = samples;
+    const std::vector<std::string> args = render_args(w);
+    std::vector<const char*> argv = {"render"};
+    for (const std::string& a : args) argv.push_back(a.c_str());
+    RenderOptions opt;
+    const std::string err = parse_render_args(int(argv.size()), argv.data(), opt);
+    if (!err.empty()) throw std::runtime_error(err);
+    opt.msaa = samples;
+    if (FrameError e = prepare_scene(render_frame_request(opt), out.frame)) throw std::runtime_error(e.message);
+    if (CameraFault f = out.frame.orbit(0.0)) throw std::runtime_error(f.message);
+    out.scene = &out.frame.scene;
+    out.settings = out.frame.settings;
 }
 
 Result measure(const Workload& w, int threads, int tile, int repeat, int width, int height, int samples,
@@ -682,36 +639,21 @@ int side_by_side(const std::vector<std::string>& exes, const std::vector<Workloa
     return 0;
 }
 
-// ---- PSNR of two 8-bit images (RGB).
+// ---- PSNR of two 8-bit images (RGB), by scene/image_diff.
 
 int psnr(const std::string& a, const std::string& b) {
-    ImageSource sa, sb;
-    sa.path = sa.name = a;
-    sb.path = sb.name = b;
-    const Image ia = decode_image(sa, false), ib = decode_image(sb, false);
-    if (ia.width != ib.width || ia.height != ib.height || !ia.is_8bit() || !ib.is_8bit()) {
-        std::fprintf(stderr, "bench: %s and %s differ in size or are not 8-bit\n", a.c_str(), b.c_str());
+    Image8 ia = read_image8(a), ib = read_image8(b);
+    if (ia.width != ib.width || ia.height != ib.height) {
+        std::fprintf(stderr, "bench: %s and %s differ in size (%dx%d and %dx%d)\n", a.c_str(), b.c_str(), ia.width,
+                     ia.height, ib.width, ib.height);
         return 1;
     }
-    double se = 0.0;
-    int max_diff = 0;
-    std::size_t differing = 0;
-    for (std::size_t i = 0; i < ia.texel_count(); ++i) {
-        bool diff = false;
-        for (int c = 0; c < 3; ++c) {
-            const int x = ia.pixels[i * std::size_t(ia.channels) + std::size_t(std::min(c, ia.channels - 1))];
-            const int y = ib.pixels[i * std::size_t(ib.channels) + std::size_t(std::min(c, ib.channels - 1))];
-            se += double(x - y) * double(x - y);
-            max_diff = std::max(max_diff, std::abs(x - y));
-            diff |= x != y;
-        }
-        differing += diff;
-    }
-    const double mse = se / (3.0 * double(ia.texel_count()));
-    if (mse == 0.0) std::printf("psnr inf dB (identical)\n");
-    else std::printf("psnr %.2f dB, max channel difference %d, %zu pixels differ (%.3f%%)\n",
-                     10.0 * std::log10(255.0 * 255.0 / mse), max_diff, differing,
-                     100.0 * double(differing) / double(ia.texel_count()));
+    ia.has_alpha = ib.has_alpha = false;  // colour only
+    const DiffResult r = diff_images(ia, ib, DiffTolerance{});
+    const double pixels = double(ia.width) * double(ia.height);
+    if (r.mse == 0.0) std::printf("psnr inf dB (identical)\n");
+    else std::printf("psnr %.2f dB, max channel difference %d, %lld pixels differ (%.3f%%)\n", r.psnr_db, r.max_diff,
+                     static_cast<long long>(r.differing), 100.0 * double(r.differing) / pixels);
     return 0;
 }
 
@@ -818,79 +760,37 @@ int bench_scene(const std::string& scene_path, int width, int height, const std:
     return 0;
 }
 
-int usage() {
-    std::fprintf(stderr,
-                 "usage: bench [--workload quad,grid,bottle,tea,bunny,builtin] [--threads 1,2] [--msaa 1,4] [--repeat N] [--json]\n"
-                 "             [--alternate]  (frames of each thread count in turn, speed-up per round)\n"
-                 "       bench SCENE [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME] [--flat]\n"
-                 "             [--shadows on|off|both] [--shadow-size N] [--blend ALPHA]\n"
-                 "       bench --write-workloads DIR\n"
-                 "       bench --side-by-side RENDER_A RENDER_B [--workload ...] [--msaa 1,4] [--runs N] [--repeat N]\n"
-                 "       bench --psnr A.png B.png\n"
-                 "options: --workloads DIR (where the synthetic workloads live; default /tmp/prast-bench-workloads)\n"
-                 "         --assets DIR (the shared assets; default ../shared/assets)\n"
-                 "         --msaa LIST (samples per pixel, default 1; side by side: given to executables that\n"
-                 "                 take --msaa; builds from before it draw 1 sample)\n");
-    return 2;
-}
-
 } // namespace
 
 int main(int argc, char** argv) {
-    std::string scene_path, write_dir, psnr_a, psnr_b;
-    std::vector<std::string> exes;
-    fs::path dir = fs::temp_directory_path() / "prast-bench-workloads";
-    fs::path assets = "../shared/assets";
-    if (const char* env = std::getenv("PRAST_SHARED_ASSETS")) assets = env;
-    int width = 1920, height = 1080, repeat = 15, runs = 5;
-    std::vector<int> msaa = {1};
-    std::vector<int> threads = {2}, tiles = {kDefaultTileSize};
-    std::vector<std::string> names;
-    DebugView view = DebugView::None;
-    bool flat = false, json = false, alternate = false, threads_given = false, tiles_given = false, blend_given = false;
-    FeatureOptions features;
-    for (int i = 1; i < argc; ++i) {
-        std::string a = argv[i];
-        auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-        if (a == "--size") {
-            if (std::sscanf(next().c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1 ||
-                width > kMaxViewportSize || height > kMaxViewportSize)
-                return usage();
-        } else if (a == "--threads") { threads = parse_list(next()); threads_given = true; }
-        else if (a == "--tiles") { tiles = parse_list(next()); tiles_given = true; }
-        else if (a == "--repeat") repeat = std::max(1, std::atoi(next().c_str()));
-        else if (a == "--msaa") {
-            msaa = parse_list(next());
-            for (int m : msaa)
-                if (m != 1 && m != 2 && m != 4 && m != 8) return usage();
-        } else if (a == "--runs") runs = std::max(1, std::atoi(next().c_str()));
-        else if (a == "--view") { if (!parse_debug_view(next(), view)) return usage(); }
-        else if (a == "--flat") flat = true;
-        else if (a == "--shadows") {
-            const std::string v = next();
-            if (v == "on") features.shadows = {true};
-            else if (v == "off") features.shadows = {false};
-            else if (v == "both") features.shadows = {false, true};
-            else return usage();
-        } else if (a == "--shadow-size") {
-            features.shadow_size = std::atoi(next().c_str());
-            if (features.shadow_size < kMinShadowSize || features.shadow_size > kMaxShadowSize) return usage();
-        } else if (a == "--blend") {
-            features.blend_alpha = float(std::atof(next().c_str()));
-            if (!(features.blend_alpha >= 0.0f && features.blend_alpha <= 1.0f)) return usage();
-            blend_given = true;
-        }
-        else if (a == "--json") json = true;
-        else if (a == "--alternate") alternate = true;
-        else if (a == "--workload") names = split(next());
-        else if (a == "--workloads") dir = next();
-        else if (a == "--assets") assets = next();
-        else if (a == "--write-workloads") write_dir = next();
-        else if (a == "--side-by-side") { exes = {next(), next()}; }
-        else if (a == "--psnr") { psnr_a = next(); psnr_b = next(); }
-        else if (!a.empty() && a[0] == '-') return usage();
-        else scene_path = a;
+    cli::BenchOptions opt;
+    opt.dir = (fs::temp_directory_path() / "prast-bench-workloads").string();
+    opt.assets = "../shared/assets";
+    if (const char* env = std::getenv("PRAST_SHARED_ASSETS")) opt.assets = env;
+    const std::string err = cli::parse_bench_args(argc, argv, opt);
+    if (!err.empty()) {
+        std::fprintf(stderr, "bench: %s\n", err.c_str());
+        return 2;
     }
+    if (opt.help) {
+        std::fputs(cli::bench_usage(), stdout);
+        return 0;
+    }
+    if (opt.version) {
+        std::printf("bench (prast) %s\n", PRAST_VERSION);
+        return 0;
+    }
+    const std::string &scene_path = opt.scene_path, &write_dir = opt.write_dir, &psnr_a = opt.psnr_a,
+                      &psnr_b = opt.psnr_b;
+    const std::vector<std::string>& exes = opt.exes;
+    const fs::path dir = opt.dir, assets = opt.assets;
+    const int width = opt.width, height = opt.height, repeat = opt.repeat, runs = opt.runs;
+    const std::vector<int>&msaa = opt.msaa, &threads = opt.threads, &tiles = opt.tiles;
+    const std::vector<std::string>& names = opt.names;
+    const DebugView view = opt.view;
+    const bool flat = opt.flat, json = opt.json, alternate = opt.alternate, threads_given = opt.threads_given,
+               tiles_given = opt.tiles_given, blend_given = opt.blend_given;
+    const FeatureOptions& features = opt;
     try {
         if (!psnr_a.empty()) return psnr(psnr_a, psnr_b);
         // A scene, a tile sweep, a debug view or the flat program: the scene mode.
@@ -909,13 +809,6 @@ int main(int argc, char** argv) {
             return 0;
         }
         const std::vector<Workload> all = workloads(dir, assets);
-        for (const std::string& name : names)
-            if (std::none_of(all.begin(), all.end(), [&](const Workload& w) { return w.name == name; })) {
-                std::string known;
-                for (const Workload& w : all) known += (known.empty() ? "" : ", ") + w.name;
-                std::fprintf(stderr, "bench: unknown workload '%s' (%s)\n", printable(name).c_str(), known.c_str());
-                return 2;
-            }
         ensure_workloads(dir, false);
         std::vector<Workload> list;
         for (const Workload& w : all) {

@@ -1,8 +1,9 @@
 // llvmpipe-render: the same frame as `render`, drawn by Mesa's llvmpipe through
 // OSMesa and OpenGL 3.3 core, for side-by-side speed comparisons
 // (`bench --side-by-side build/llvmpipe-render build/render`). It takes
-// render's command line (apps/render_options.h), loads the scene with prast's
-// own loaders and image decoders, frames and lights it as render does, and
+// render's command line (apps/render_options.h), sets the frame up with
+// render's own set-up (renderer/frame_setup.h: the scene, camera, lights and
+// memory check), decodes the textures with prast's own decoders, and
 // shades with a GLSL port of the conventions' Cook-Torrance (shading/brdf.h,
 // surface.h): metal-roughness maps, tangent-space normal maps, occlusion,
 // emissive, suns and point lights, the flat ambient term, exposure and the ACES
@@ -42,14 +43,12 @@
 #include <string>
 #include <vector>
 
+#include "apps/frame_request.h"
 #include "apps/render_options.h"
+#include "renderer/frame_setup.h"
 #include "scene/camera.h"
-#include "scene/camera_request.h"
-#include "scene/default_scene.h"
 #include "scene/image.h"
-#include "scene/load_scene.h"
 #include "scene/write_image.h"
-#include "renderer/scene_renderer.h"
 
 using namespace prast;
 
@@ -350,32 +349,20 @@ int main(int argc, char** argv) {
     // llvmpipe reads its thread count once, when the context is made.
     if (opt.threads > 0) setenv("LP_NUM_THREADS", std::to_string(opt.threads).c_str(), 1);
 
-    // Scene, camera and lights exactly as render sets them up (frame 0).
-    Scene scene;
-    Camera camera;
-    const auto t_load = Clock::now();
-    if (opt.scene.empty()) {
-        DefaultScene d = make_default_scene();
-        scene = std::move(d.scene);
-        camera = d.camera;
-    } else {
-        try {
-            scene = load_scene(opt.scene);
-        } catch (const std::exception& e) {
-            die(e.what());
-        }
-    }
-    const double load_ms = ms_since(t_load);
-    const Bounds bounds = scene.bounds();
-    const float aspect = float(opt.width) / float(opt.height);
-    const CameraRequest camera_request = opt.camera_request();
-    if (CameraFault f = request_camera(camera_request, bounds, aspect, !opt.scene.empty(), camera, camera))
-        die(f.message);
-    if (CameraFault f = orbit_camera(camera_request, camera, bounds, 0.0, camera)) die(f.message);
-    // No environment here: the default rig whenever render's would light a scene without an --env.
-    bool used_default_rig = false;
-    const std::vector<ShadingLight> lights =
-        frame_lights(scene, opt.lights, opt.no_default_lights, false, used_default_rig);
+    // Scene, camera and lights from render's own frame set-up (frame 0),
+    // with its memory check; the textures are decoded and uploaded below.
+    FrameSetup setup;
+    if (FrameError e = prepare_scene(render_frame_request(opt), setup)) die(e.message, e.code);
+    if (CameraFault f = setup.orbit(0.0)) die(f.message, kFrameExitUsage);
+    for (const std::string& n : setup.notes) std::fprintf(stderr, "llvmpipe-render: %s\n", n.c_str());
+    if (setup.environment_image)
+        std::fprintf(stderr, "llvmpipe-render: warning: image-based lighting is not ported: the environment "
+                             "map is not drawn (the lights and the ambient term are)\n");
+    const Scene& scene = setup.scene;
+    const Camera& camera = setup.settings.camera;
+    const std::vector<ShadingLight>& lights = setup.settings.lights;
+    const double load_ms = setup.load_ms;
+    const float aspect = setup.aspect();
     if (lights.size() > 8) die("more than 8 lights");
 
     // A GL 3.3 core context. Its OSMesa window (client memory, copied there on

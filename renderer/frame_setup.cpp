@@ -1,0 +1,157 @@
+// The frame set-up; see frame_setup.h. The order of the steps is the order of
+// the messages a tool prints, and each float is computed once, here.
+#include "renderer/frame_setup.h"
+
+#include <chrono>
+
+#include "scene/default_scene.h"
+#include "scene/load_environment.h"
+#include "scene/load_scene.h"
+#include "scene/messages.h"
+#include "renderer/memory_plan.h"
+
+namespace prast {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+void stage(const FrameStageHook& hook, FrameStage s) {
+    if (hook) hook(s);
+}
+
+void add_warnings(FrameSetup& f, const std::vector<std::string>& warnings) {
+    for (const std::string& w : f.request.cap_warnings ? cap_warnings(warnings) : warnings)
+        f.notes.push_back("warning: " + w);
+}
+
+} // namespace
+
+CameraFault FrameSetup::orbit(double radians) {
+    return orbit_camera(request.camera_request(), base_camera, bounds, radians, settings.camera);
+}
+
+FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameStageHook& on_stage) {
+    out.request = req;
+
+    // The scene, or the built-in one with its own camera.
+    stage(on_stage, FrameStage::Load);
+    const auto t_load = Clock::now();
+    Camera camera;
+    if (req.scene.empty()) {
+        DefaultScene d = make_default_scene();
+        out.scene = std::move(d.scene);
+        camera = d.camera;
+    } else {
+        LoadOptions load_options;
+        load_options.allow_outside_paths = req.allow_outside_paths;
+        try {
+            out.scene = load_scene(req.scene, load_options);
+        } catch (const LoadError& e) {
+            return {kFrameExitBadFile, e.what()};
+        }
+    }
+    out.load_ms = ms_since(t_load);
+    add_warnings(out, out.scene.warnings);
+
+    // The camera: the built-in scene's own, or framed on the bounds; the
+    // flags override single fields.
+    out.bounds = out.scene.bounds();
+    if (CameraFault f = request_camera(req.camera_request(), out.bounds, out.aspect(), !req.scene.empty(), camera,
+                                       out.base_camera))
+        return {f.kind == CameraFault::Flag ? kFrameExitUsage : kFrameExitBadFile, f.message};
+    out.settings.camera = out.base_camera;
+
+    // The lights: the scene's and the flags'; the default rig only when
+    // neither has any and no environment (--env, or the scene's own sky)
+    // lights the scene.
+    out.settings.lights = frame_lights(out.scene, req.lights, req.no_default_lights,
+                                       out.scene.environment || !req.env.empty(), out.used_default_rig);
+
+    // The whole job must fit in memory before anything big is allocated.
+    stage(on_stage, FrameStage::PlanMemory);
+    MemoryPlan plan = plan_memory(out.scene, req.width, req.height, req.bytes_per_pixel);
+    plan_environment(plan, out.scene, req.env);
+    plan_shadows(plan, out.settings.lights, req.shadows);
+    if (req.recording) plan_recording(plan, out.scene, req.width, req.height, req.samples);
+    const std::uint64_t budget = memory_budget();
+    if (plan.total() > budget)
+        return {kFrameExitBadFile, (req.scene.empty() ? std::string("the built-in scene") : req.scene) +
+                                       (req.recording ? ": recording the frame needs " : ": the render needs ") +
+                                       plan.describe() + ", more than the " + std::to_string(budget) +
+                                       " bytes allowed (half the physical memory)"};
+
+    // The environment: the --env file, or the scene's own (the built-in sky).
+    out.environment_image = out.scene.environment;
+    if (!req.env.empty()) {
+        try {
+            out.environment_image = std::make_shared<const Image>(load_environment_hdr(req.env));
+        } catch (const LoadError& e) {
+            return {kFrameExitBadFile, e.what()};
+        }
+    }
+
+    FrameSettings& s = out.settings;
+    s.ambient = req.ambient;
+    s.model = req.brdf;
+    s.view = req.view;
+    s.ibl = req.ibl;
+    s.ibl_samples = req.ibl_samples;
+    s.energy = req.energy;
+    s.background = req.background;
+    s.background_color = req.background_color;
+    s.samples = req.samples;
+    s.shadows = req.shadows;
+
+    if (out.used_default_rig)
+        out.notes.push_back("no lights in the scene or flags: using the default key+fill rig "
+                            "(--no-default-lights to disable)");
+    if (out.environment_image && req.ambient_given)
+        out.notes.push_back("warning: --ambient is not used: the environment map replaces the ambient term");
+    return {};
+}
+
+FrameError start_renderer(FrameSetup& out, const FrameStageHook& on_stage) {
+    const FrameRequest& req = out.request;
+    FrameSettings& s = out.settings;
+    stage(on_stage, FrameStage::StartThreads);
+    const auto t_tex = Clock::now();
+    RendererOptions ro;
+    ro.threads = req.threads;
+    ro.tile_size = req.tile_size;
+    out.renderer = std::make_unique<Renderer>(ro);
+    if (!out.renderer->pool().started_fewer().empty())
+        out.notes.push_back("warning: " + out.renderer->pool().started_fewer() + "; rendering with " +
+                            std::to_string(out.renderer->threads()));
+    stage(on_stage, FrameStage::DecodeTextures);
+    out.scene_renderer = std::make_unique<SceneRenderer>(out.scene, *out.renderer);
+    out.textures_ms = ms_since(t_tex);
+    add_warnings(out, out.scene_renderer->warnings());
+
+    // Prefiltered once for all frames, on the renderer's threads.
+    const auto t_env = Clock::now();
+    if (out.environment_image) {
+        stage(on_stage, FrameStage::PrefilterEnvironment);
+        EnvironmentSettings es;
+        es.intensity = req.env_intensity;
+        es.rotate_deg = req.env_rotate_deg;
+        es.importance_sampling = req.env_importance_sampling;
+        out.environment =
+            std::make_unique<Environment>(Environment::build(*out.environment_image, es, out.renderer->pool()));
+    }
+    s.environment = out.environment.get();
+    s.scene_environment = false;
+    out.environment_ms = ms_since(t_env);
+    return {};
+}
+
+FrameError setup_frame(const FrameRequest& request, FrameSetup& out, const FrameStageHook& on_stage) {
+    if (FrameError e = prepare_scene(request, out, on_stage)) return e;
+    return start_renderer(out, on_stage);
+}
+
+} // namespace prast
