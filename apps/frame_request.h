@@ -44,6 +44,10 @@ inline FrameRequest render_frame_request(const RenderOptions& opt) {
     r.threads = opt.threads;
     r.tile_size = opt.tile_size;
     r.bytes_per_pixel = kBytesPerPixel;
+    r.time = opt.time;
+    r.animation = opt.animation;
+    r.camera = opt.camera;
+    r.fps = opt.fps;
     return r;
 }
 

@@ -35,7 +35,9 @@
 #include "raster/pipeline.h"
 #include "renderer/frame_setup.h"
 #include "renderer/scene_renderer.h"
+#include "scene/animation.h"
 #include "scene/camera.h"
+#include "scene/load_scene.h"
 #include "scene/messages.h"
 #include "scene/write_image.h"
 #include "shading/ibl/environment.h"
@@ -216,6 +218,7 @@ PixelHit cast_pixel_ray(const Scene& scene, const Camera& cam, int width, int he
     float best = 1.0f;  // ray parameter: 0 at the near plane, 1 at the far plane
     for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
         const Mesh& mesh = scene.meshes[m];
+        if (mesh.topology != Mesh::Topology::Triangles) continue;  // a ray meets no 1-pixel line
         const bool two_sided = mesh.material >= 0 && std::size_t(mesh.material) < scene.materials.size() &&
                                scene.materials[std::size_t(mesh.material)].double_sided;
         for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
@@ -286,7 +289,11 @@ SurfacePoint surface_at_hit(const Mesh& mesh, const PixelHit& hit, const Camera&
 void print_pixel_ibl(SceneRenderer& sr, const FrameSettings& settings, const Mesh& mesh, const PixelHit& hit,
                      int width, int height, glm::ivec2 px, int samples) {
     static const Material kFallback;
-    static const BoundMaterial kFallbackBound{&kFallback};
+    static const BoundMaterial kFallbackBound = [] {
+        BoundMaterial b;
+        b.m = &kFallback;
+        return b;
+    }();
     const BoundMaterial& bm = mesh.material >= 0 && std::size_t(mesh.material) < sr.materials().size()
                                   ? sr.materials()[std::size_t(mesh.material)] : kFallbackBound;
     const SurfacePoint sp = surface_at_hit(mesh, hit, settings.camera, width, height, px);
@@ -333,6 +340,77 @@ void print_pixel(const Scene& scene, const Camera& cam, const Framebuffer& fb, c
     if (sr.environment(settings)) print_pixel_ibl(sr, settings, mesh, hit, fb.width, fb.height, px, ibl_samples);
 }
 
+// render --list: what the model holds, one item a line, names escaped.
+int list_model(const RenderOptions& opt) {
+    Scene scene;
+    LoadOptions load_options;
+    load_options.allow_outside_paths = opt.allow_outside_paths;
+    try {
+        scene = load_scene(opt.scene, load_options);
+    } catch (const LoadError& e) {
+        std::fprintf(stderr, "render: %s\n", printable(e.what()).c_str());
+        return kExitBadFile;
+    }
+    for (const std::string& w : cap_warnings(scene.warnings))
+        std::fprintf(stderr, "render: warning: %s\n", printable(w).c_str());
+    const SceneSource* src = scene.source.get();
+    auto name = [](const std::string& s) { return "'" + printable(cut(s)) + "'"; };
+    std::printf("model %s\n", printable(opt.scene).c_str());
+    std::printf("meshes %zu (%zu triangles)\n", scene.meshes.size(), scene.triangle_count());
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+        const Mesh& m = scene.meshes[i];
+        const char* kind = m.topology == Mesh::Topology::Lines ? "lines" : m.topology == Mesh::Topology::Points ? "points" : "triangles";
+        const std::size_t per = m.topology == Mesh::Topology::Lines ? 2 : m.topology == Mesh::Topology::Points ? 1 : 3;
+        std::string extra;
+        if (src && m.source_node >= 0 && std::size_t(m.source_node) < src->nodes.size()) {
+            const SourceNode& node = src->nodes[std::size_t(m.source_node)];
+            extra += ", node " + std::to_string(m.source_node);
+            if (node.skin >= 0) extra += ", skin " + std::to_string(node.skin);
+            if (node.mesh >= 0 && src->meshes[std::size_t(node.mesh)].target_count > 0)
+                extra += ", " + std::to_string(src->meshes[std::size_t(node.mesh)].target_count) + " morph targets";
+        }
+        std::printf("  mesh %zu %s: %zu %s, %zu vertices, material %d%s\n", i, name(m.name).c_str(),
+                    m.indices.size() / per, kind, m.positions.size(), m.material, extra.c_str());
+    }
+    std::printf("materials %zu\n", scene.materials.size());
+    for (std::size_t i = 0; i < scene.materials.size(); ++i)
+        std::printf("  material %zu %s\n", i, name(scene.materials[i].name).c_str());
+    std::printf("cameras %zu\n", scene.cameras.size());
+    for (std::size_t i = 0; i < scene.cameras.size(); ++i) {
+        const SceneCamera& c = scene.cameras[i];
+        if (c.orthographic)
+            std::printf("  camera %zu %s: orthographic, xmag %g ymag %g, znear %g zfar %g, node %d\n", i,
+                        name(c.name).c_str(), c.xmag, c.ymag, c.znear, c.zfar, c.node);
+        else if (c.zfar > 0.0)
+            std::printf("  camera %zu %s: perspective, yfov %g degrees, znear %g zfar %g, node %d\n", i,
+                        name(c.name).c_str(), glm::degrees(c.yfov), c.znear, c.zfar, c.node);
+        else
+            std::printf("  camera %zu %s: perspective, yfov %g degrees, znear %g zfar infinite, node %d\n", i,
+                        name(c.name).c_str(), glm::degrees(c.yfov), c.znear, c.node);
+    }
+    std::printf("animations %zu\n", scene.animation_names.size());
+    for (std::size_t i = 0; src && i < src->animations.size(); ++i) {
+        const Animation& a = src->animations[i];
+        std::size_t paths[4] = {0, 0, 0, 0};
+        for (const AnimationChannel& c : a.channels) ++paths[int(c.path)];
+        std::printf("  animation %zu %s: %g s (keys %g to %g s), %zu channels: %zu translation, %zu rotation, "
+                    "%zu scale, %zu weights\n",
+                    i, name(a.name).c_str(), a.end, a.start, a.end, a.channels.size(), paths[0], paths[1], paths[2],
+                    paths[3]);
+    }
+    std::printf("skins %zu\n", src ? src->skins.size() : std::size_t(0));
+    for (std::size_t i = 0; src && i < src->skins.size(); ++i)
+        std::printf("  skin %zu: %zu joints\n", i, src->skins[i].joints.size());
+    auto joined = [](const std::vector<std::string>& v) {
+        std::string out;
+        for (const std::string& s : v) out += (out.empty() ? "" : ", ") + printable(cut(s));
+        return out.empty() ? std::string("none") : out;
+    };
+    std::printf("extensions used: %s\n", joined(scene.extensions_used).c_str());
+    std::printf("extensions required: %s\n", joined(scene.extensions_required).c_str());
+    return 0;
+}
+
 int run(int argc, char** argv) {
     install_signal_cleanup();
     RenderOptions opt;
@@ -350,6 +428,7 @@ int run(int argc, char** argv) {
         return 0;
     }
 
+    if (opt.list) return list_model(opt);
     // Fail on an unwritable output before spending time on the render: every
     // frame's directory, so a turntable cannot fail half-way.
     const render_cli::FramePattern pattern(opt.output);
@@ -430,9 +509,12 @@ int run(int argc, char** argv) {
     std::vector<double> frame_ms;
     int step = 2;
     for (int index = opt.first_frame; index <= opt.last_frame; ++index) {
-        // Frame i of a turntable sits at angle i * DEG / N around the target.
-        const double angle = glm::radians(double(index) * opt.orbit_deg / double(opt.frames));
-        if (CameraFault f = frame.orbit(angle)) return fail(kExitUsage, f.message);
+        // Frame i of a turntable sits at angle i * DEG / N around the target;
+        // frame i of a sequence (--fps) at time --time + i / F, still unless --orbit.
+        const double angle = opt.fps > 0.0 && !opt.orbit_given
+                                 ? 0.0
+                                 : glm::radians(double(index) * opt.orbit_deg / double(opt.frames));
+        if (CameraFault f = frame.set_frame(index, angle)) return fail(kExitUsage, f.message);
 
         double render_ms = 0.0;
         for (int r = 0; r < opt.repeat; ++r) {

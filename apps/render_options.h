@@ -50,8 +50,9 @@ constexpr long kMaxFrames = 1000000;
 constexpr long kMaxRepeat = 100000;
 constexpr long kMaxIblSamples = 1 << 20;
 constexpr double kMaxEnvIntensity = 1e6;
+constexpr double kMaxAnimationTime = 1e9;  // seconds; beyond, float key times mean nothing
 
-// Samples per pixel unless --msaa says otherwise: README "Anti-aliasing"
+// Samples per pixel unless --msaa says otherwise: docs/pipeline.md "Anti-aliasing"
 // gives the measurements behind it.
 constexpr int kDefaultMsaa = 4;
 
@@ -86,11 +87,19 @@ struct RenderOptions {
     DebugView view = DebugView::None;
     int threads = 0;                   // 0: all hardware threads
     int tile_size = kDefaultTileSize;
-    int msaa = kDefaultMsaa;           // samples per pixel (README "Anti-aliasing")
+    int msaa = kDefaultMsaa;           // samples per pixel (docs/pipeline.md "Anti-aliasing")
     int frames = 1;
     double orbit_deg = 360.0;          // total turntable angle over `frames`
     bool orbit_given = false;
     int first_frame = 0, last_frame = 0;  // inclusive, 0-based
+    // Animation (scene/animation.h): the time of frame 0, which animation
+    // (a name or an index; empty: every one), and with --fps a sequence
+    // through time instead of a turntable.
+    double time = 0.0;
+    std::string animation;
+    double fps = 0.0;                  // 0: --frames is a turntable
+    std::string camera;                // --camera: a camera of the file (name or index); empty: framed
+    bool list = false;                 // --list: print the model's contents instead of rendering
     bool frame_range_given = false;
     int repeat = 1;
     bool repeat_given = false;         // print the frame_ms line

@@ -87,6 +87,17 @@ void image_seeds() {
     put("png", "grey2-interlaced.png", pc::file(17, 3, 2, 0, 1, 2, wave));
     put("png", "palette4-interlaced.png",
         pc::file(12, 12, 4, 3, 1, 4, wave, pc::chunk("PLTE", plte.substr(0, 48))));
+    // Sides beyond stb_image's 32768, which only libpng decodes (8 and 16 bits).
+    put("png", "grey8-40000x1.png", pc::file(40000, 1, 8, 0, 0, 8, wave));
+    put("png", "grey16-1x33000.png", pc::file(1, 33000, 16, 0, 0, 16, wave));
+    // A top-down BMP (negative height), whose height stbi_info gives negative.
+    std::string bmp = "BM";
+    const auto le32 = [&bmp](std::uint32_t v) { bmp += {char(v), char(v >> 8), char(v >> 16), char(v >> 24)}; };
+    const auto le16 = [&bmp](unsigned v) { bmp += {char(v), char(v >> 8)}; };
+    le32(54 + 2 * 8); le32(0); le32(54); le32(40); le32(2); le32(std::uint32_t(-2)); le16(1); le16(24);
+    le32(0); le32(16); le32(2835); le32(2835); le32(0); le32(0);
+    bmp += std::string("\x00\x00\xff\x00\xff\x00\x00\x00\xff\x00\x00\xff\xff\xff\x00\x00", 16);
+    put("png", "top-down.bmp", bmp);
 
     // Radiance: width 8..32767 is written run-length encoded, below 8 flat.
     const int hdr_sizes[][2] = {{4, 3}, {8, 2}, {16, 4}, {40, 3}};
@@ -230,6 +241,93 @@ void gltf_seeds() {
     u32(0x004E4942u);
     glb += glb_bin;
     put("gltf", "full.glb", glb);
+
+    // A required extension with gltfpack's uri-less fallback buffer, and
+    // texCoord values beyond an int.
+    put("gltf", "meshopt-required.gltf",
+        R"({"asset":{"version":"2.0"},"extensionsUsed":["EXT_meshopt_compression"],)"
+        R"("extensionsRequired":["EXT_meshopt_compression"],)"
+        R"("buffers":[{"byteLength":42,"extensions":{"EXT_meshopt_compression":{"fallback":true}}},)"
+        R"({"uri":"b.bin","byteLength":42}],"bufferViews":[{"buffer":0,"byteLength":36,)"
+        R"("extensions":{"EXT_meshopt_compression":{"buffer":1,"byteLength":36,"byteStride":12,"count":3}}}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})");
+    put("gltf", "texcoord-range.gltf",
+        R"({"asset":{"version":"2.0"},"buffers":[{"uri":"b.bin","byteLength":42}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0}]}],"nodes":[{"mesh":0}],)"
+        R"("scenes":[{"nodes":[0]}],"images":[{"uri":"t.png"}],"textures":[{"source":0}],)"
+        R"("materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0,"texCoord":2147483648}},)"
+        R"("normalTexture":{"index":0,"texCoord":4294967296},"emissiveTexture":{"index":0,"texCoord":-1}}]})");
+
+    // Every primitive mode over b.bin's triangle (b.bin is 256 bytes; 3 indices: a one-triangle
+    // strip and fan, a 3-segment loop, an odd LINES count), and a bad mode.
+    std::string modes = R"({"asset":{"version":"2.0"},"buffers":[{"uri":"b.bin","byteLength":256}],)"
+                        R"("bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":6}],)"
+                        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},)"
+                        R"({"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}],"meshes":[{"primitives":[)";
+    for (int mode = 0; mode <= 7; ++mode)
+        modes += std::string(mode ? "," : "") + R"({"attributes":{"POSITION":0},"indices":1,"mode":)" +
+                 std::to_string(mode) + "}";
+    modes += R"(,{"attributes":{"POSITION":0},"mode":5}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})";
+    put("gltf", "modes.gltf", modes);
+
+    // COLOR_0 as float VEC4, normalized unsigned byte VEC4 and unsigned short
+    // VEC3; TEXCOORD_1 read by a texture; two textures of one image with
+    // their own samplers (every filter, and bad enums).
+    std::string cb;
+    auto cf = [&](float v) { cb.append(reinterpret_cast<const char*>(&v), 4); };
+    for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) cf(v);           // 0: positions
+    for (float v : {1.f, 0.f, 0.f, 1.f, 0.f, 1.f, 0.f, .5f, 0.f, 0.f, 1.f, 0.f}) cf(v);  // 36: float rgba
+    for (int b : {255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0}) cb += char(b);     // 84: u8 rgba
+    for (int i = 0; i < 9; ++i) { const std::uint16_t v = std::uint16_t(i * 8191); cb.append(reinterpret_cast<const char*>(&v), 2); }  // 96: u16 rgb
+    cb += std::string(2, '\0');
+    for (float v : {0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) cf(v);                           // 116: uv1
+    const std::string colors =
+        R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":)" + std::to_string(cb.size()) +
+        R"(,"uri":"data:application/octet-stream;base64,)" + base64(cb) + R"("}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":48},)"
+        R"({"buffer":0,"byteOffset":84,"byteLength":12},{"buffer":0,"byteOffset":96,"byteLength":18},)"
+        R"({"buffer":0,"byteOffset":116,"byteLength":24}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},)"
+        R"({"bufferView":1,"componentType":5126,"count":3,"type":"VEC4"},)"
+        R"({"bufferView":2,"componentType":5121,"normalized":true,"count":3,"type":"VEC4"},)"
+        R"({"bufferView":3,"componentType":5123,"normalized":true,"count":3,"type":"VEC3"},)"
+        R"({"bufferView":4,"componentType":5126,"count":3,"type":"VEC2"}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0,"COLOR_0":1,"TEXCOORD_0":4,"TEXCOORD_1":4},"material":0},)"
+        R"({"attributes":{"POSITION":0,"COLOR_0":2},"mode":3},{"attributes":{"POSITION":0,"COLOR_0":3},"mode":0},)"
+        R"({"attributes":{"POSITION":0,"COLOR_0":0,"COLOR_1":1},"material":1}]}],)"
+        R"("nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"images":[{"uri":"t.png"}],)"
+        R"("samplers":[{"magFilter":9728,"minFilter":9984},{"magFilter":9729,"minFilter":9985},)"
+        R"({"minFilter":9986,"wrapS":33648},{"minFilter":9987},{"magFilter":1,"minFilter":4294977024}],)"
+        R"("textures":[{"source":0,"sampler":0},{"source":0,"sampler":1},{"source":0,"sampler":2},)"
+        R"({"source":0,"sampler":3},{"source":0,"sampler":4}],)"
+        R"("materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0,"texCoord":1},)"
+        R"("metallicRoughnessTexture":{"index":1}},"normalTexture":{"index":2,"texCoord":1},)"
+        R"("occlusionTexture":{"index":3},"emissiveTexture":{"index":4}},{"name":"plain"}]})";
+    put("gltf", "colors-uv1-samplers.gltf", colors);
+
+    // Specular-glossiness: factors only, and both textures (converted texel
+    // by texel); minVersion 2.0 (loads) and 2.1 (refused).
+    put("gltf", "spec-gloss.gltf",
+        R"({"asset":{"version":"2.0","minVersion":"2.0"},"extensionsUsed":["KHR_materials_pbrSpecularGlossiness"],)"
+        R"("extensionsRequired":["KHR_materials_pbrSpecularGlossiness"],"buffers":[{"uri":"b.bin","byteLength":256}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":6}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},)"
+        R"({"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0},)"
+        R"({"attributes":{"POSITION":0},"indices":1,"material":1}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],)"
+        R"("images":[{"uri":"t.png"},{"uri":"sub/t.png"}],"textures":[{"source":0},{"source":1}],)"
+        R"("materials":[{"extensions":{"KHR_materials_pbrSpecularGlossiness":{"diffuseFactor":[0.5,0.4,0.3,0.8],)"
+        R"("specularFactor":[0.2,0.2,0.2],"glossinessFactor":0.7}}},)"
+        R"({"extensions":{"KHR_materials_pbrSpecularGlossiness":{"diffuseTexture":{"index":0},)"
+        R"("specularGlossinessTexture":{"index":1},"specularFactor":[1,0.8,0.2]}}}]})");
+    put("gltf", "min-version.gltf",
+        R"({"asset":{"version":"2.1","minVersion":"2.1"},"buffers":[{"uri":"b.bin","byteLength":256}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})");
 }
 
 void cli_seeds() {

@@ -6,10 +6,12 @@
 // per-job stage: assemble, clip, cull, set up, bin.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
 #include "raster/clip.h"
+#include "raster/line.h"
 #include "raster/observer.h"
 #include "raster/samples.h"
 #include "raster/setup.h"
@@ -30,6 +32,7 @@ struct TileGrid {
 
 struct BinJob {
     std::vector<TriangleSetup> setups;
+    std::vector<LineSetup> lines;            // a job of a line or point draw: its items index these
     std::vector<float> clip_pool;            // vertices made by clipping, `stride` floats each
     std::vector<std::uint64_t> pairs;        // (tile << 32 | setup index), before sorting
     std::vector<std::uint32_t> tile_offsets; // tiles + 1
@@ -39,6 +42,7 @@ struct BinJob {
 
     void reset() {
         setups.clear();
+        lines.clear();
         clip_pool.clear();
         pairs.clear();
         stats = FrameStats{};
@@ -184,6 +188,78 @@ void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, cons
             any_back |= r == SetupResult::CulledBack;
         }
         count(any_setup, any_back);
+    }
+}
+
+// Appends the tiles that line or point `index` of `job` may cover to
+// job.pairs: tile columns (x-major) or rows along the segment, and in each
+// the tiles of the minor axis within a pixel of it.
+inline void bin_line(BinJob& job, std::uint32_t index, const TileGrid& grid) {
+    const LineSetup& l = job.lines[index];
+    const int T = grid.tile_size;
+    auto push = [&](int tx, int ty) {
+        job.pairs.push_back((std::uint64_t(std::uint32_t(ty * grid.tiles_x + tx)) << 32) | index);
+    };
+    if (l.point) {
+        push(l.minx / T, l.miny / T);
+        return;
+    }
+    const int major_min = l.x_major ? l.minx : l.miny, major_max = l.x_major ? l.maxx : l.maxy;
+    const int minor_min = l.x_major ? l.miny : l.minx, minor_max = l.x_major ? l.maxy : l.maxx;
+    for (int t = major_min / T; t <= major_max / T; ++t) {
+        const int p0 = std::max(t * T, major_min), p1 = std::min(t * T + T - 1, major_max);
+        int lo, hi;
+        if (!raster_detail::line_minor_range(l, p0, p1, lo, hi)) continue;
+        lo = std::max(lo, minor_min);
+        hi = std::min(hi, minor_max);
+        for (int u = lo / T; lo <= hi && u <= hi / T; ++u) {
+            if (l.x_major) push(t, u);
+            else push(u, t);
+        }
+    }
+}
+
+// The stage of bin_triangles() for a draw of lines (`points` false: index
+// pairs) or points: assemble, drop invalid ones, clip (lines; points outside
+// the near or far plane are dropped), set up and bin primitives
+// [begin, end). Observers are not told of lines and points (they speak of
+// triangles); they see the draw's vertices.
+inline void bin_lines(BinJob& job, std::size_t begin, std::size_t end, const std::uint32_t* indices,
+                      const float* vertices, const std::uint16_t* codes, const WindowVertex* window,
+                      std::uint32_t vertex_count, int stride, const TileGrid& grid, bool points) {
+    const GuardBand gb = GuardBand::for_viewport(grid.width, grid.height);
+    const int per = points ? 1 : 2;
+    float seg[2 * (4 + kMaxVaryings)];
+    for (std::size_t p = begin; p < end; ++p) {
+        std::uint32_t ref[2] = {indices[per * p], indices[per * p + per - 1]};
+        if (ref[0] >= vertex_count || ref[1] >= vertex_count ||
+            ((codes[ref[0]] | codes[ref[1]]) & kVertexNotFinite))
+            continue;
+        const std::uint32_t oc0 = codes[ref[0]], oc1 = codes[ref[1]];
+        LineSetup l;
+        bool ok;
+        if (points) {
+            ok = !(oc0 & (kOutNear | kOutFar)) && setup_point(window[ref[0]], ref[0], grid.width, grid.height, l);
+        } else if (oc0 & oc1 & kFrustumBits) {
+            ok = false;
+        } else if (const std::uint32_t planes = (oc0 | oc1) & kClipNeededBits) {
+            ok = clip_line(&vertices[std::size_t(ref[0]) * stride], &vertices[std::size_t(ref[1]) * stride], stride,
+                           planes, gb, seg);
+            if (ok) {
+                const std::uint32_t base = std::uint32_t(job.clip_pool.size() / std::size_t(stride));
+                job.clip_pool.insert(job.clip_pool.end(), seg, seg + 2 * stride);
+                const std::uint32_t pref[2] = {base | kClippedVertexBit, (base + 1) | kClippedVertexBit};
+                ok = setup_line(window_vertex(seg, grid.width, grid.height),
+                                window_vertex(seg + stride, grid.width, grid.height), pref, grid.width, grid.height, l);
+            }
+        } else {
+            ok = setup_line(window[ref[0]], window[ref[1]], ref, grid.width, grid.height, l);
+        }
+        if (!ok) continue;
+        l.prim_id = std::uint32_t(p);
+        const std::uint32_t index = std::uint32_t(job.lines.size());
+        job.lines.push_back(l);
+        bin_line(job, index, grid);
     }
 }
 

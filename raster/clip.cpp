@@ -109,4 +109,43 @@ int clip_triangle(const float* const v[3], int stride, std::uint32_t planes,
     return n;
 }
 
+bool clip_line(const float* a, const float* b, int stride, std::uint32_t planes, const GuardBand& gb,
+               float* out) {
+    static const std::uint32_t kOrder[kClipPlanes] = {kOutNear, kOutFar, kOutGuardLeft,
+                                                      kOutGuardRight, kOutGuardBottom, kOutGuardTop};
+    double t0 = 0.0, t1 = 1.0;
+    std::uint32_t cut0 = 0, cut1 = 0;
+    for (std::uint32_t plane : kOrder) {
+        if (!(planes & plane)) continue;
+        const double da = plane_distance(plane, a, gb), db = plane_distance(plane, b, gb);
+        if (da < 0.0 && db < 0.0) return false;
+        if (!(da < 0.0) && !(db < 0.0)) continue;
+        const double t = da / (da - db);  // where a -> b meets the plane
+        if (!(t >= 0.0 && t <= 1.0)) return false;  // NaN from a broken vertex
+        if (da < 0.0 && t > t0) {
+            t0 = t;
+            cut0 = plane;
+        } else if (db < 0.0 && t < t1) {
+            t1 = t;
+            cut1 = plane;
+        }
+    }
+    if (t0 > t1) return false;
+    float* o0 = out;
+    float* o1 = out + stride;
+    if (cut0) {
+        lerp_vertex(a, b, t0, stride, o0);
+        snap_to_plane(cut0, gb, o0);
+    } else {
+        std::memcpy(o0, a, sizeof(float) * std::size_t(stride));
+    }
+    if (cut1) {
+        lerp_vertex(a, b, t1, stride, o1);
+        snap_to_plane(cut1, gb, o1);
+    } else {
+        std::memcpy(o1, b, sizeof(float) * std::size_t(stride));
+    }
+    return true;
+}
+
 } // namespace prast

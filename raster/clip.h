@@ -36,4 +36,11 @@ std::uint32_t outcode(const float* clip, const GuardBand& gb);
 int clip_triangle(const float* const v[3], int stride, std::uint32_t planes,
                   const GuardBand& gb, float* out);
 
+// Clips segment (a, b) against the planes named in `planes`: writes the
+// remaining segment's two vertices into out (2 * stride floats) and returns
+// true, or false when nothing is left. Each new end is cut along a -> b and
+// put exactly on its plane.
+bool clip_line(const float* a, const float* b, int stride, std::uint32_t planes, const GuardBand& gb,
+               float* out);
+
 } // namespace prast

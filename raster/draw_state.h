@@ -11,6 +11,12 @@ enum class CullMode { Back, None };   // None = double-sided
 // ONE_MINUS_SRC_ALPHA) does (transparency; usually with depth_write off).
 enum class Blend { Replace, Add, Alpha };
 
+// What a draw's indices list: triangles (3 each), line segments (2 each) or
+// points (1 each). Lines and points are 1 pixel wide; their rules (the
+// diamond-exit rule, the pixel a point lies in, every sample of a covered
+// pixel) are in raster/line.h. `cull` does not apply to them.
+enum class Topology : unsigned char { Triangles, Lines, Points };
+
 struct DrawState {
     CullMode cull = CullMode::Back;
     Blend blend = Blend::Replace;
@@ -23,6 +29,7 @@ struct DrawState {
     // kills without this flag set breaks that contract: its kills are honoured
     // only as "colour not written" after the depth was already written.
     bool may_discard = false;
+    Topology topology = Topology::Triangles;
 };
 
 } // namespace prast

@@ -25,6 +25,7 @@
 #include "raster/bin.h"
 #include "raster/draw_state.h"
 #include "raster/fragment.h"
+#include "raster/line_raster.h"
 #include "raster/observer.h"
 #include "raster/rasterize.h"
 #include "raster/shade.h"
@@ -92,7 +93,7 @@ struct has_fragment_batch<P, std::void_t<decltype(std::declval<const P&>().fragm
                                  std::declval<const FragmentBlock<P::kVaryings>* const*>(),
                                  std::declval<FragmentOut* const*>(), 0))>> : std::true_type {};
 
-namespace detail {
+namespace raster_detail {
 
 // A winner's block waiting to be shaded in a batch.
 struct WinnerBlock {
@@ -128,6 +129,8 @@ public:
     // Sparse winner blocks of this draw, one batch (count <= kMaxBatchBlocks,
     // kBlockLanes lanes together; draws with `batches`).
     virtual void shade_winners(const WinnerBlock* blocks, int count, TileContext& c) = 0;
+    // Lines and points (state.topology): items [begin, end) of a job, in order.
+    virtual void rasterize_lines(const BinJob& job, std::uint32_t begin, std::uint32_t end, TileContext& c) = 0;
 
     DrawState state;
     DrawMode mode = DrawMode::InOrder;
@@ -137,7 +140,7 @@ public:
     int stride = 4;
     std::uint32_t vertex_count = 0;
     const std::uint32_t* indices = nullptr;
-    std::size_t tri_count = 0;
+    std::size_t tri_count = 0;  // primitives: triangles, lines or points (state.topology)
     std::vector<float>* vertices = nullptr;  // post-vertex-shader, stride floats each
     std::vector<std::uint16_t>* outcodes = nullptr;  // project_vertices() of each vertex
     std::vector<WindowVertex>* window = nullptr;     // ... and its window position
@@ -154,9 +157,22 @@ public:
     }
     void bin(BinJob& job, std::size_t tri_begin, std::size_t tri_end, const TileGrid& grid,
              const SampleExtent& samples) override {
+        if (state.topology != Topology::Triangles) {
+            bin_lines(job, tri_begin, tri_end, indices, vertices->data(), outcodes->data(), window->data(),
+                      vertex_count, stride, grid, state.topology == Topology::Points);
+            return;
+        }
         bin_triangles(job, tri_begin, tri_end, indices, vertices->data(), outcodes->data(), window->data(),
                       vertex_count, stride, grid, samples,
                       state.cull == CullMode::Back, *obs_);
+    }
+    void rasterize_lines(const BinJob& job, std::uint32_t begin, std::uint32_t end, TileContext& c) override {
+        constexpr bool shade = has_fragment<Program>::value;
+        const bool depth_only = mode == DrawMode::DepthOnly;
+        if (c.sample_count() == 1)
+            raster_detail::rasterize_lines<false, shade>(program_, state, depth_only, vertices->data(), job, begin, end, c);
+        else
+            raster_detail::rasterize_lines<true, shade>(program_, state, depth_only, vertices->data(), job, begin, end, c);
     }
     // Each entry dispatches once on the sample count: one sample is compiled
     // on its own, with the loops over samples gone.
@@ -181,9 +197,9 @@ public:
                       std::uint32_t lanes, const std::uint32_t* won) override {
         if constexpr (has_fragment<Program>::value) {
             if (c.sample_count() == 1)
-                detail::shade_winner<false>(program_, vertices->data(), job, t, c, bx, by, lanes, won, *obs_);
+                raster_detail::shade_winner<false>(program_, vertices->data(), job, t, c, bx, by, lanes, won, *obs_);
             else
-                detail::shade_winner<true>(program_, vertices->data(), job, t, c, bx, by, lanes, won, *obs_);
+                raster_detail::shade_winner<true>(program_, vertices->data(), job, t, c, bx, by, lanes, won, *obs_);
         } else {
             (void)t; (void)job; (void)c; (void)bx; (void)by; (void)lanes; (void)won;
         }
@@ -263,5 +279,5 @@ struct TileScratch {
     std::vector<Ref> refs;
 };
 
-} // namespace detail
+} // namespace raster_detail
 } // namespace prast

@@ -69,16 +69,16 @@ struct NullObserver {
     void samples(std::uint32_t, int, int, const SampleCoverage&) {}
 };
 
-namespace detail {
+namespace raster_detail {
 template <class O, class = void>
 struct has_samples_event : std::false_type {};
 template <class O>
 struct has_samples_event<O, std::void_t<decltype(std::declval<O&>().samples(
                                 std::uint32_t(), 0, 0, std::declval<const SampleCoverage&>()))>>
     : std::true_type {};
-} // namespace detail
+} // namespace raster_detail
 
 template <class Observer>
-constexpr bool observes_samples = Observer::enabled && detail::has_samples_event<Observer>::value;
+constexpr bool observes_samples = Observer::enabled && raster_detail::has_samples_event<Observer>::value;
 
 } // namespace prast

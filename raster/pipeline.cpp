@@ -101,7 +101,7 @@ void Renderer::finish(TileHook hook, void* user) {
     const GuardBand guard_band = GuardBand::for_viewport(grid_.width, grid_.height);
     std::vector<int> vchunk_end(std::size_t(ndraws) + 1, 0);
     for (int d = 0; d < ndraws; ++d) {
-        detail::DrawRecord& dr = *draws_[std::size_t(d)];
+        raster_detail::DrawRecord& dr = *draws_[std::size_t(d)];
         dr.vertices = &vertex_buffers_[std::size_t(d)];
         dr.vertices->resize(std::size_t(dr.vertex_count) * std::size_t(dr.stride));
         dr.outcodes = &outcode_buffers_[std::size_t(d)];
@@ -114,7 +114,7 @@ void Renderer::finish(TileHook hook, void* user) {
     }
     pool_.run(vchunk_end.back(), [&](int task, int) {
         const int d = int(std::upper_bound(vchunk_end.begin(), vchunk_end.end(), task) - vchunk_end.begin()) - 1;
-        detail::DrawRecord& dr = *draws_[std::size_t(d)];
+        raster_detail::DrawRecord& dr = *draws_[std::size_t(d)];
         const std::uint32_t begin = std::uint32_t(task - vchunk_end[std::size_t(d)]) * kVertexChunk;
         const std::uint32_t end = std::min<std::uint32_t>(dr.vertex_count, begin + kVertexChunk);
         dr.shade_vertices(begin, end);
@@ -132,7 +132,7 @@ void Renderer::finish(TileHook hook, void* user) {
     };
     std::vector<JobRange> ranges;
     for (int d = 0; d < ndraws; ++d) {
-        detail::DrawRecord& dr = *draws_[std::size_t(d)];
+        raster_detail::DrawRecord& dr = *draws_[std::size_t(d)];
         const std::size_t per_job =
             std::max<std::size_t>(kTrianglesPerJob, (dr.tri_count + kMaxJobs - 1) / kMaxJobs);
         dr.first_job = int(ranges.size());
@@ -147,7 +147,8 @@ void Renderer::finish(TileHook hook, void* user) {
         BinJob& job = jobs_[std::size_t(j)];
         const JobRange& r = ranges[std::size_t(j)];
         job.reset();
-        job.setups.reserve(r.end - r.begin);
+        if (draws_[std::size_t(r.draw)]->state.topology == Topology::Triangles) job.setups.reserve(r.end - r.begin);
+        else job.lines.reserve(r.end - r.begin);
         draws_[std::size_t(r.draw)]->bin(job, r.begin, r.end, grid_, extent);
         sort_bins(job, tiles);
     });
@@ -187,7 +188,7 @@ void Renderer::finish(TileHook hook, void* user) {
         for (int s = 0; s < S; ++s) std::memcpy(samples + 4 * s, options_.clear_color, 4 * sizeof(float));
         resolve_samples_local(samples, 1, S, 1, 1, uniform_color);
     }
-    for (detail::TileScratch& sc : scratch_) {
+    for (raster_detail::TileScratch& sc : scratch_) {
         if (sc.winner.size() != plane * std::size_t(S)) sc.winner.assign(plane * std::size_t(S), kNoWinner);
         sc.dirty.assign(std::size_t((blocks + 63) / 64), 0);
         if (S > 1 || transient) {
@@ -217,7 +218,7 @@ void Renderer::finish(TileHook hook, void* user) {
 
 void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     Framebuffer& fb = *fb_;
-    detail::TileScratch& sc = scratch_[std::size_t(worker)];
+    raster_detail::TileScratch& sc = scratch_[std::size_t(worker)];
     FrameStats& stats = worker_stats_[std::size_t(worker)];
     const int S = options_.samples;
     const int T = tile_size_;
@@ -263,7 +264,7 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     // A tile no draw reaches keeps its cleared colour and depth (one colour
     // unless a fill paints a background).
     bool reached = false;
-    for (const std::unique_ptr<detail::DrawRecord>& dp : draws_)
+    for (const std::unique_ptr<raster_detail::DrawRecord>& dp : draws_)
         for (int j = dp->first_job; j < dp->first_job + dp->job_count && !reached; ++j) {
             const BinJob& job = jobs_[std::size_t(j)];
             reached = job.tile_offsets[std::size_t(tile)] != job.tile_offsets[std::size_t(tile) + 1];
@@ -313,8 +314,8 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     bool defer = options_.visibility == FrameOptions::Visibility::Always;
     if (options_.visibility == FrameOptions::Visibility::Auto) {
         float covered = 0.0f;
-        for (const std::unique_ptr<detail::DrawRecord>& dp : draws_) {
-            if (dp->mode != detail::DrawMode::Visible) continue;
+        for (const std::unique_ptr<raster_detail::DrawRecord>& dp : draws_) {
+            if (dp->mode != raster_detail::DrawMode::Visible) continue;
             defer |= dp->observed;
             for (int j = dp->first_job; j < dp->first_job + dp->job_count; ++j) {
                 const BinJob& job = jobs_[std::size_t(j)];
@@ -337,11 +338,11 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     // Every draw's bins, in submission order.
     bool touched = false, pending = false;
     sc.refs.clear();
-    for (const std::unique_ptr<detail::DrawRecord>& dp : draws_) {
-        detail::DrawRecord& d = *dp;
+    for (const std::unique_ptr<raster_detail::DrawRecord>& dp : draws_) {
+        raster_detail::DrawRecord& d = *dp;
         // Shaded here, triangle by triangle (not depth only, not left to the
         // visibility pass's winners).
-        const bool in_order = d.mode == detail::DrawMode::InOrder || (d.mode == detail::DrawMode::Visible && !defer);
+        const bool in_order = d.mode == raster_detail::DrawMode::InOrder || (d.mode == raster_detail::DrawMode::Visible && !defer);
         bool flushed = false;
         for (int j = d.first_job; j < d.first_job + d.job_count; ++j) {
             const BinJob& job = jobs_[std::size_t(j)];
@@ -354,17 +355,21 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
                 pending = false;
                 flushed = true;
             }
+            if (d.state.topology != Topology::Triangles) {
+                d.rasterize_lines(job, begin, end, c);
+                continue;
+            }
             if (d.batches && in_order) {
                 d.rasterize_in_order_batched(job, begin, end, c);
                 continue;
             }
             for (std::uint32_t i = begin; i < end; ++i) {
-                if (i + 2 < end) detail::prefetch_setup(job.setups[job.items[i + 2]]);
+                if (i + 2 < end) raster_detail::prefetch_setup(job.setups[job.items[i + 2]]);
                 if (i + 1 < end && in_order)
-                    detail::prefetch_varyings(job.setups[job.items[i + 1]], d.vertices->data(), job, d.stride);
+                    raster_detail::prefetch_varyings(job.setups[job.items[i + 1]], d.vertices->data(), job, d.stride);
                 const TriangleSetup& t = job.setups[job.items[i]];
                 switch (d.mode) {
-                case detail::DrawMode::Visible:
+                case raster_detail::DrawMode::Visible:
                     if (!defer) {
                         d.rasterize_in_order(t, job, c);
                         break;
@@ -373,10 +378,10 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
                     sc.refs.push_back({&d, &job, &t});
                     pending = true;
                     break;
-                case detail::DrawMode::DepthOnly:
+                case raster_detail::DrawMode::DepthOnly:
                     d.rasterize_visible(t, c, kNoWinner);
                     break;
-                case detail::DrawMode::InOrder:
+                case raster_detail::DrawMode::InOrder:
                     d.rasterize_in_order(t, job, c);
                     break;
                 }
@@ -415,14 +420,14 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
 
 // Shades every winner of the tile once per block it won samples in, then
 // returns the winners to kNoWinner.
-void Renderer::flush_winners(TileContext& c, detail::TileScratch& sc) {
+void Renderer::flush_winners(TileContext& c, raster_detail::TileScratch& sc) {
     const int S = c.sample_count();
     const TileTarget& tg = c.target;
     const std::size_t words = sc.dirty.size();
     // Sparse winner blocks wait for a batch of their draw (winners own their
     // samples, so the order of the writes does not matter).
-    detail::WinnerBlock batch[kMaxBatchBlocks];
-    detail::DrawRecord* batch_draw = nullptr;
+    raster_detail::WinnerBlock batch[kMaxBatchBlocks];
+    raster_detail::DrawRecord* batch_draw = nullptr;
     int batch_count = 0, batch_lanes = 0;
     auto flush_batch = [&] {
         if (batch_count) batch_draw->shade_winners(batch, batch_count, c);
@@ -436,7 +441,7 @@ void Renderer::flush_winners(TileContext& c, detail::TileScratch& sc) {
             alignas(32) std::uint32_t ids[kMaxSamples][kBlockLanes];
             std::uint32_t remaining[kMaxSamples];
             for (int s = 0; s < S; ++s) {
-                detail::load_winners(win + s * tg.wplane, tg.wrow, ids[s]);
+                raster_detail::load_winners(win + s * tg.wplane, tg.wrow, ids[s]);
                 remaining[s] = ~equal_mask(ids[s], kNoWinner) & 0xFFFFu;
             }
             for (int s0 = 0; s0 < S; ++s0) {
@@ -448,7 +453,7 @@ void Renderer::flush_winners(TileContext& c, detail::TileScratch& sc) {
                         remaining[s] &= ~won[s];
                         lanes |= won[s];
                     }
-                    const detail::TileScratch::Ref& ref = sc.refs[k];
+                    const raster_detail::TileScratch::Ref& ref = sc.refs[k];
                     const int n = __builtin_popcount(lanes);
                     const bool joins = batch_count && batch_draw == ref.draw && batch_count < kMaxBatchBlocks &&
                                        batch_lanes + n <= kBlockLanes;
@@ -457,8 +462,8 @@ void Renderer::flush_winners(TileContext& c, detail::TileScratch& sc) {
                         continue;
                     }
                     if (!joins) flush_batch();
-                    detail::prefetch_setup(*ref.tri);  // read when the batch is shaded
-                    detail::WinnerBlock& wb = batch[batch_count++];
+                    raster_detail::prefetch_setup(*ref.tri);  // read when the batch is shaded
+                    raster_detail::WinnerBlock& wb = batch[batch_count++];
                     wb.tri = ref.tri;
                     wb.job = ref.job;
                     wb.bx = bx;
@@ -468,7 +473,7 @@ void Renderer::flush_winners(TileContext& c, detail::TileScratch& sc) {
                     batch_draw = ref.draw;
                     batch_lanes += n;
                 }
-                detail::store_winner(win + s0 * tg.wplane, tg.wrow, 0xFFFFu, kNoWinner);
+                raster_detail::store_winner(win + s0 * tg.wplane, tg.wrow, 0xFFFFu, kNoWinner);
             }
         }
         sc.dirty[w] = 0;

@@ -38,9 +38,11 @@ struct RendererOptions {
 
 // Whether a draw with a fragment program into a colour target has its
 // winners shaded once, after the visibility pass (else it is shaded in
-// submission order): what submit() chooses, and what the stepper records.
+// submission order; always for lines and points): what submit() chooses,
+// and what the stepper records.
 inline bool shades_after_visibility(const DrawState& state, FrameOptions::Visibility visibility) {
-    return visibility != FrameOptions::Visibility::Never && state.depth_test && state.depth_write &&
+    return visibility != FrameOptions::Visibility::Never && state.topology == Topology::Triangles &&
+           state.depth_test && state.depth_write &&
            state.blend == Blend::Replace && !state.may_discard;
 }
 
@@ -76,10 +78,14 @@ public:
     // count other than 1, 2, 4, 8, or a frame already begun.
     void begin(Framebuffer& fb, const FrameOptions& options = {});
 
-    // Records a draw of an indexed triangle list (index_count / 3 triangles).
+    // Records a draw of an indexed triangle list (index_count / 3 triangles),
+    // or with state.topology Lines / Points a list of line segments
+    // (index_count / 2 index pairs) or points (index_count), drawn 1 pixel
+    // wide by the rules of raster/line.h, always shaded in submission order
+    // (no visibility pass), observers told of their vertices only.
     // The program is copied; indices, everything the program points to and
     // the observer must live until end(). Indices out of range and non-finite
-    // positions drop their triangle (counted as invalid).
+    // positions drop their triangle (counted as invalid) or line or point.
     template <class Program, class Observer>
     void submit(const Program& program, std::uint32_t vertex_count, const std::uint32_t* indices,
                 std::size_t index_count, const DrawState& state, Observer& observer);
@@ -127,7 +133,7 @@ private:
     void abandon() { fb_ = nullptr; draws_.clear(); }
     void finish(TileHook hook, void* user);
     void run_tile(int tile, int worker, TileHook hook, void* user);
-    void flush_winners(TileContext& c, detail::TileScratch& sc);
+    void flush_winners(TileContext& c, raster_detail::TileScratch& sc);
 
     ThreadPool pool_;
     int tile_size_;
@@ -137,14 +143,14 @@ private:
     Framebuffer* fb_ = nullptr;
     FrameOptions options_;
     TileGrid grid_;
-    std::vector<std::unique_ptr<detail::DrawRecord>> draws_;
+    std::vector<std::unique_ptr<raster_detail::DrawRecord>> draws_;
 
     // Storage reused from frame to frame.
     std::vector<std::vector<float>> vertex_buffers_;   // by draw slot
     std::vector<std::vector<std::uint16_t>> outcode_buffers_;  // by draw slot
     std::vector<std::vector<WindowVertex>> window_buffers_;     // by draw slot
     std::vector<BinJob> jobs_;                         // every draw's, in submission order
-    std::vector<detail::TileScratch> scratch_;         // by worker
+    std::vector<raster_detail::TileScratch> scratch_;         // by worker
     std::vector<float> uniform_tile_;                  // transient frames: a tile of the resolved clear colour
     std::vector<FrameStats> worker_stats_;
     std::vector<std::uint32_t> frame_entries_;         // per tile, this frame
@@ -161,15 +167,16 @@ void Renderer::submit(const Program& program, std::uint32_t vertex_count, const 
     static_assert(NV >= 0 && NV <= kMaxVaryings, "too many varyings");
     if (!fb_) throw std::logic_error("Renderer::submit outside begin()/end()");
     ++stats_.draws;
-    const std::size_t tri_count = index_count / 3;
+    const std::size_t per = state.topology == Topology::Triangles ? 3 : state.topology == Topology::Lines ? 2 : 1;
+    const std::size_t tri_count = index_count / per;
     if (tri_count == 0) return;
-    auto d = std::make_unique<detail::Draw<Program, Observer>>(program, observer);
+    auto d = std::make_unique<raster_detail::Draw<Program, Observer>>(program, observer);
     d->state = state;
     d->stride = 4 + NV;
     d->vertex_count = vertex_count;
     d->indices = indices;
     d->tri_count = tri_count;
-    using detail::DrawMode;
+    using raster_detail::DrawMode;
     if (!has_fragment<Program>::value || (!fb_->has_color() && !state.may_discard)) {
         d->mode = DrawMode::DepthOnly;
     } else if (fb_->has_color() && shades_after_visibility(state, options_.visibility)) {
@@ -179,7 +186,8 @@ void Renderer::submit(const Program& program, std::uint32_t vertex_count, const 
     }
     d->reads_color = fb_->has_color() && state.blend != Blend::Replace;
     d->observed = Observer::enabled;
-    d->batches = has_fragment_batch<Program>::value && !Observer::enabled && !state.may_discard;
+    d->batches = has_fragment_batch<Program>::value && !Observer::enabled && !state.may_discard &&
+                 state.topology == Topology::Triangles;
     draws_.push_back(std::move(d));
 }
 

@@ -62,7 +62,7 @@ struct TileContext {
     }
 };
 
-namespace detail {
+namespace raster_detail {
 
 inline int popcount16(std::uint32_t m) { return __builtin_popcount(m & 0xFFFFu); }
 
@@ -499,5 +499,5 @@ void rasterize_depth(const TriangleSetup& t, TileContext& c, bool depth_test, bo
     });
 }
 
-} // namespace detail
+} // namespace raster_detail
 } // namespace prast

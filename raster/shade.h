@@ -22,7 +22,7 @@
 #include "raster/rasterize.h"
 
 namespace prast {
-namespace detail {
+namespace raster_detail {
 
 // A triangle's varyings as (v0, v1 - v0, v2 - v0), from the draw's vertices or
 // the clip pool of the job that made them.
@@ -421,5 +421,5 @@ template <bool MS, class Program>
     for (int s = 0; s < samples_of<MS>(c); ++s) batch.write[i][s] = bs.pass[s];
 }
 
-} // namespace detail
+} // namespace raster_detail
 } // namespace prast

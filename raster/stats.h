@@ -17,7 +17,7 @@ struct FrameStats {
     std::uint64_t triangles_degenerate = 0;    // zero area after snapping, or no pixel centre
     std::uint64_t triangles_clipped = 0;   // needed near/far/guard-band clipping
     std::uint64_t triangles_setup = 0;     // reached the bins (after clipping: may exceed triangles_in)
-    std::uint64_t bin_entries = 0;         // (triangle, tile) pairs
+    std::uint64_t bin_entries = 0;         // (triangle, tile) pairs (and (line, tile), (point, tile))
     std::uint64_t tiles_touched = 0;       // tiles with at least one bin entry
     std::uint64_t blocks_rasterized = 0;   // 4x4 blocks with coverage
     std::uint64_t quads_shaded = 0;        // 2x2 quads handed to the fragment shader with >= 1 live lane

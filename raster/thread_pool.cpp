@@ -2,8 +2,14 @@
 #include "raster/thread_pool.h"
 
 #include <chrono>
+#include <cstdint>
+#include <cstdio>
 #include <ctime>
 #include <system_error>
+
+#include <pthread.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 namespace prast {
 
@@ -34,12 +40,59 @@ private:
     double c0_;
 };
 
+std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (std::uint64_t(1) << 19)) >> 20) + " MiB"; }
+
+// The address space a new thread takes: its stack and guard as the default
+// thread attributes give them (std::thread uses those).
+std::uint64_t thread_reservation() {
+    pthread_attr_t attr;
+    std::size_t stack = 0, guard = 0;
+    if (pthread_getattr_default_np(&attr) == 0) {
+        pthread_attr_getstacksize(&attr, &stack);
+        pthread_attr_getguardsize(&attr, &guard);
+        pthread_attr_destroy(&attr);
+    }
+    return stack == 0 ? std::uint64_t(8) << 20 : std::uint64_t(stack) + std::uint64_t(guard);
+}
+
+// The address space the process has mapped (/proc/self/statm), 0 when unknown.
+std::uint64_t mapped_bytes() {
+    std::FILE* f = std::fopen("/proc/self/statm", "r");
+    if (!f) return 0;
+    unsigned long long pages = 0;
+    const int got = std::fscanf(f, "%llu", &pages);
+    std::fclose(f);
+    const long page = sysconf(_SC_PAGE_SIZE);
+    return got == 1 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page) : 0;
+}
+
+// Under an address-space limit (ulimit -v), how many more threads may start
+// so that their stacks take at most half of what is left: each reserves its
+// whole stack (8 MiB by default) whether it uses it or not, so a thousand
+// threads would leave the render itself nothing. "" in `why` when all may.
+int threads_that_fit(int wanted, std::string& why) {
+    rlimit limit{};
+    if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return wanted;
+    const std::uint64_t cap = std::uint64_t(limit.rlim_cur), used = mapped_bytes();
+    const std::uint64_t room = cap > used ? (cap - used) / 2 : 0;
+    const std::uint64_t each = thread_reservation();
+    if (std::uint64_t(wanted) * each <= room) return wanted;
+    why = "their " + mib(each) + " stacks would take more than half of the " + mib(cap > used ? cap - used : 0) +
+          " of address space left under ulimit -v";
+    return int(room / each);
+}
+
 } // namespace
 
 ThreadPool::ThreadPool(int threads) : requested_(threads < 1 ? 1 : threads) {
     usage_.resize(std::size_t(requested_));
-    workers_.reserve(std::size_t(requested_ - 1));
-    for (int i = 1; i < requested_; ++i) {
+    std::string why;
+    const int workers = threads_that_fit(requested_ - 1, why);
+    if (!why.empty())
+        started_fewer_ = "could start only " + std::to_string(workers + 1) + " of " + std::to_string(requested_) +
+                         " threads (" + why + ")";
+    workers_.reserve(std::size_t(workers));
+    for (int i = 1; i <= workers; ++i) {
         try {
             workers_.emplace_back([this, i] { worker_loop(i); });
         } catch (const std::system_error& e) {

@@ -4,7 +4,9 @@
 //
 // Failures stay on the caller's side: a pool that cannot start all its threads
 // (a process limit, no memory for a stack) runs with those it got and says so
-// in started_fewer(); an exception thrown by a task (std::bad_alloc, ...)
+// in started_fewer(), and under an address-space limit (ulimit -v) it starts
+// no more than fit in half of what is left, since every thread reserves a
+// whole stack and the render needs the rest; an exception thrown by a task (std::bad_alloc, ...)
 // stops the run's remaining tasks and is rethrown by run() on the calling
 // thread once every worker is back, so nothing calls std::terminate.
 #pragma once
@@ -30,7 +32,9 @@ public:
     int size() const { return int(workers_.size()) + 1; }
     int requested() const { return requested_; }
     // "" when all requested threads run; else why fewer do, e.g. "could start
-    // only 37 of 1024 threads (Resource temporarily unavailable)".
+    // only 37 of 1024 threads (Resource temporarily unavailable)" or "could
+    // start only 511 of 1000 threads (their 8 MiB stacks would take more than
+    // half of the 8165 MiB of address space left under ulimit -v)".
     const std::string& started_fewer() const { return started_fewer_; }
 
     // Runs fn(task, worker) for task in [0, count); worker in [0, size()).

@@ -2,8 +2,10 @@
 // the messages a tool prints, and each float is computed once, here.
 #include "renderer/frame_setup.h"
 
+#include <algorithm>
 #include <chrono>
 
+#include "scene/animation.h"
 #include "scene/default_scene.h"
 #include "scene/load_environment.h"
 #include "scene/load_scene.h"
@@ -29,10 +31,53 @@ void add_warnings(FrameSetup& f, const std::vector<std::string>& warnings) {
         f.notes.push_back("warning: " + w);
 }
 
+// "FLAG 'VALUE': SCENE has no WHAT of that name or index (...)", listing
+// what there is.
+std::string not_found(const std::string& flag, const std::string& value, const std::string& scene,
+                      const char* what, const std::vector<std::string>& names) {
+    std::string have;
+    for (std::size_t i = 0; i < names.size() && i < 8; ++i)
+        have += (i ? ", " : "") + std::to_string(i) + " '" + cut(names[i]) + "'";
+    if (names.size() > 8) have += ", ...";
+    return flag + " '" + cut(value) + "': " + scene + " has no " + what + " of that name or index (" +
+           (names.empty() ? std::string("it has none") : "it has " + have) + ")";
+}
+
 } // namespace
 
 CameraFault FrameSetup::orbit(double radians) {
-    return orbit_camera(request.camera_request(), base_camera, bounds, radians, settings.camera);
+    if (file_camera < 0) return orbit_camera(request.camera_request(), base_camera, bounds, radians, settings.camera);
+    Camera cam = scene_camera(scene, file_camera, time, aspect(), animation);
+    if (request.near_plane) cam.near_plane = *request.near_plane;
+    if (request.far_plane) {
+        cam.far_plane = *request.far_plane;
+        cam.infinite_far = false;
+    } else if (cam.infinite_far && !bounds.empty()) {
+        // The projection has no far plane; what fits to the view (shadow
+        // maps) reads this one, which encloses the scene.
+        cam.far_plane = std::max(cam.near_plane * 2.0f,
+                                 glm::length(cam.eye - bounds.center()) + std::max(bounds.radius(), 1e-4f) * 1.05f);
+    }
+    if (!(cam.near_plane < cam.far_plane) && !cam.infinite_far)
+        return {CameraFault::Flag, "--near/--far: near " + std::to_string(cam.near_plane) +
+                                       " is not less than the camera's far " + std::to_string(cam.far_plane)};
+    settings.camera = cam;
+    return {};
+}
+
+CameraFault FrameSetup::set_frame(int index, double radians) {
+    const double t = frame_time(index);
+    if (scene.source && !scene.animation_names.empty() && t != time) {
+        pose_scene(scene, t, animation);
+        time = t;
+        bounds = first_bounds;
+        const Bounds now = scene.bounds();
+        if (!now.empty()) {
+            bounds.add(now.lo);
+            bounds.add(now.hi);
+        }
+    }
+    return orbit(radians);
 }
 
 FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameStageHook& on_stage) {
@@ -58,12 +103,35 @@ FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameSt
     out.load_ms = ms_since(t_load);
     add_warnings(out, out.scene.warnings);
 
+    // The animation and the file camera the flags name, then the pose of
+    // frame 0 (the loader gives the rest pose).
+    const std::string scene_name = req.scene.empty() ? std::string("the built-in scene") : req.scene;
+    out.animation = kAllAnimations;
+    if (!req.animation.empty()) {
+        out.animation = find_named(out.scene.animation_names, req.animation);
+        if (out.animation < 0)
+            return {kFrameExitUsage,
+                    not_found("--animation", req.animation, scene_name, "animation", out.scene.animation_names)};
+    }
+    if (!req.camera.empty()) {
+        std::vector<std::string> names;
+        for (const SceneCamera& c : out.scene.cameras) names.push_back(c.name);
+        out.file_camera = find_named(names, req.camera);
+        if (out.file_camera < 0) return {kFrameExitUsage, not_found("--camera", req.camera, scene_name, "camera", names)};
+    }
+    out.time = req.time;
+    if (out.scene.source && !out.scene.animation_names.empty()) pose_scene(out.scene, req.time, out.animation);
+
     // The camera: the built-in scene's own, or framed on the bounds; the
     // flags override single fields.
     out.bounds = out.scene.bounds();
-    if (CameraFault f = request_camera(req.camera_request(), out.bounds, out.aspect(), !req.scene.empty(), camera,
-                                       out.base_camera))
+    out.first_bounds = out.bounds;
+    if (out.file_camera >= 0) {
+        out.base_camera = scene_camera(out.scene, out.file_camera, out.time, out.aspect(), out.animation);
+    } else if (CameraFault f = request_camera(req.camera_request(), out.bounds, out.aspect(), !req.scene.empty(),
+                                              camera, out.base_camera)) {
         return {f.kind == CameraFault::Flag ? kFrameExitUsage : kFrameExitBadFile, f.message};
+    }
     out.settings.camera = out.base_camera;
 
     // The lights: the scene's and the flags'; the default rig only when

@@ -66,6 +66,13 @@ struct FrameRequest {
     std::uint64_t bytes_per_pixel = 24;      // framebuffer and output image, for the memory plan
     bool recording = false;                  // step: the plan counts the recording of the frame
     bool cap_warnings = true;                // at most a few warnings of each kind (scene/messages.h)
+    // Animation (scene/animation.h): frame i is at time + i / fps (fps 0:
+    // every frame at `time`), of the animation named (empty: every one);
+    // `camera` names a camera of the file (empty: framed, or the flags').
+    double time = 0.0;
+    std::string animation;
+    std::string camera;
+    double fps = 0.0;
 
     CameraRequest camera_request() const {
         return {scene, eye, target, up, fov_deg, near_plane, far_plane};
@@ -94,6 +101,10 @@ struct FrameSetup {
     Scene scene;
     Bounds bounds;
     Camera base_camera;                      // the turntable's base: framed, then the flags
+    int animation = -1;                      // scene/animation.h: kAllAnimations or an index
+    int file_camera = -1;                    // index into scene.cameras; -1: framed
+    double time = 0.0;                       // the time the scene is posed at
+    Bounds first_bounds;                     // the bounds at frame 0, which framed the camera
     bool used_default_rig = false;
     std::shared_ptr<const Image> environment_image;  // --env's, or the scene's own
     FrameSettings settings;                  // camera: the base until orbit() sets a frame's
@@ -107,6 +118,14 @@ struct FrameSetup {
     // The turntable's camera at `radians` around the base camera's target
     // and up, into settings.camera; a fault is the flags' (--near/--far).
     CameraFault orbit(double radians);
+    // Frame `index` of a sequence or turntable: the scene posed at its time
+    // (request.time + index / request.fps), then the camera as orbit()
+    // sets it, or the file's camera at that time; clip planes fitted to the
+    // bounds of frame 0 and of this frame together.
+    CameraFault set_frame(int index, double radians);
+    double frame_time(int index) const {
+        return request.fps > 0.0 ? request.time + double(index) / request.fps : request.time;
+    }
 
     int width() const { return request.width; }
     int height() const { return request.height; }

@@ -74,7 +74,8 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
                                {&m.normal, false}, {&m.occlusion, false}})
             if (slot_of(*r, srgb) >= 0) direct[std::size_t(slot_of(*r, srgb))] = 1;
         const int rs = slot_of(m.roughness, false), ms = slot_of(m.metallic, false);
-        if (rs >= 0 && ms >= 0 && rs != ms && !m.metallic_roughness.valid() && wraps_of(rs) == wraps_of(ms)) {
+        if (rs >= 0 && ms >= 0 && rs != ms && !m.metallic_roughness.valid() && wraps_of(rs) == wraps_of(ms) &&
+            m.roughness.texcoord == m.metallic.texcoord) {
             const auto key = std::make_pair(rs, ms);
             auto it = std::find(packs.begin(), packs.end(), key);
             material_pack[mi] = int(it - packs.begin());
@@ -147,9 +148,21 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
     for (const std::string& e : errors)
         if (!e.empty()) warnings_.push_back(e + " (texture ignored)");
 
+    // Each reference samples the shared decoded texels through its own
+    // sampler: the decoded texture itself when the samplers agree, else one
+    // view per (image, colour space, sampler).
     auto bind = [&](const TextureRef& r, bool srgb) -> const Texture* {
         const int slot = slot_of(r, srgb);
-        return slot >= 0 ? textures_[std::size_t(slot)].get() : nullptr;
+        const Texture* base = slot >= 0 ? textures_[std::size_t(slot)].get() : nullptr;
+        const SamplerState want = sampler_of(r);
+        if (!base || base->sampler() == want) return base;
+        for (const std::unique_ptr<Texture>& v : views_)
+            if (v->shares_storage(*base) && v->sampler() == want) return v.get();
+        views_.push_back(std::make_unique<Texture>(base->with_sampler(want)));
+        return views_.back().get();
+    };
+    auto set_of = [](const TextureRef& r) {
+        return std::uint8_t(r.texcoord > 0 && r.texcoord < kMaxUvSets ? r.texcoord : 0);
     };
     for (std::size_t mi = 0; mi < scene.materials.size(); ++mi) {
         const Material& m = scene.materials[mi];
@@ -167,6 +180,13 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
         }
         b.normal = bind(m.normal, false);
         b.occlusion = bind(m.occlusion, false);
+        b.uv.base_color = set_of(m.base_color);
+        b.uv.emissive = set_of(m.emissive);
+        b.uv.metallic_roughness = set_of(p >= 0 && pack_ok[std::size_t(p)] ? m.roughness : m.metallic_roughness);
+        b.uv.roughness = set_of(m.roughness);
+        b.uv.metallic = set_of(m.metallic);
+        b.uv.normal = set_of(m.normal);
+        b.uv.occlusion = set_of(m.occlusion);
         bound_.push_back(b);
     }
 }
@@ -178,10 +198,13 @@ std::vector<ShadingLight> SceneRenderer::shadowed_lights(const FrameSettings& s,
         for (ShadingLight& L : lights) L.shadow = nullptr;
         return lights;
     }
-    // The maps depend on the camera, the aspect, the lights and the size only.
+    // The maps depend on the camera, the aspect, the lights, the size and the
+    // scene's pose only.
     const Camera& c = s.camera;
     std::vector<float> key = {aspect, float(s.shadows.size), c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y,
-                              c.target.z, c.up.x, c.up.y, c.up.z, c.fov_y_deg, c.near_plane, c.far_plane};
+                              c.target.z, c.up.x, c.up.y, c.up.z, c.fov_y_deg, c.near_plane, c.far_plane,
+                              float(c.orthographic), c.ortho_ymag, float(c.infinite_far),
+                              float(scene_.pose_serial & 0xffffffu), float(scene_.pose_serial >> 24)};
     for (const ShadingLight& L : lights)
         key.insert(key.end(), {float(L.point), L.direction.x, L.direction.y, L.direction.z, L.position.x,
                                L.position.y, L.position.z});
@@ -277,9 +300,9 @@ void SceneRenderer::begin_pass(const FrameSettings& s, Framebuffer& fb, const Im
     pass.order = draw_order(scene_, s.camera.eye);
 }
 
-PbrProgram SceneRenderer::program(const FrameSettings& s, const Pass& pass, const Mesh& mesh,
-                                  const BoundMaterial& bm) const {
-    PbrProgram prog;
+template <class P>
+P SceneRenderer::program_of(const FrameSettings& s, const Pass& pass, const Mesh& mesh, const BoundMaterial& bm) const {
+    P prog;
     prog.mesh = &mesh;
     prog.view_proj = pass.view_proj;
     prog.material = &bm;
@@ -288,6 +311,16 @@ PbrProgram SceneRenderer::program(const FrameSettings& s, const Pass& pass, cons
     prog.near_plane = s.camera.near_plane;
     prog.far_plane = s.camera.far_plane;
     return prog;
+}
+
+PbrProgram SceneRenderer::program(const FrameSettings& s, const Pass& pass, const Mesh& mesh,
+                                  const BoundMaterial& bm) const {
+    return program_of<PbrProgram>(s, pass, mesh, bm);
+}
+
+PbrProgramExt SceneRenderer::program_ext(const FrameSettings& s, const Pass& pass, const Mesh& mesh,
+                                         const BoundMaterial& bm) const {
+    return program_of<PbrProgramExt>(s, pass, mesh, bm);
 }
 
 void SceneRenderer::end_pass(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out, const Pass& pass) {

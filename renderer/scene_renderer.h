@@ -85,6 +85,38 @@ struct SceneDraw {
     DrawState state;
 };
 
+// Lines and points without normals, which glTF draws unlit: base colour
+// factor x base colour texture x vertex colour (COLOR_0) as the radiance, its
+// alpha blended (BLEND) or tested (MASK) as the PBR program does. Lines and
+// points shade with zero derivatives, so the texture's finest level is read.
+struct UnlitProgram {
+    static constexpr int kVaryings = 6;  // uv, rgba
+    const Mesh* mesh = nullptr;
+    glm::mat4 view_proj{1.0f};
+    const BoundMaterial* material = nullptr;
+
+    void vertex(std::uint32_t i, float clip[4], float* var) const {
+        const glm::vec4 c = view_proj * glm::vec4(mesh->positions[i], 1.0f);
+        clip[0] = c.x; clip[1] = c.y; clip[2] = c.z; clip[3] = c.w;
+        const std::vector<glm::vec2>& uvs = material->m->base_color.texcoord == 1 ? mesh->uvs1 : mesh->uvs;
+        const glm::vec2 uv = i < uvs.size() ? uvs[i] : glm::vec2(0.0f);
+        const glm::vec4 rgba = i < mesh->colors.size() ? mesh->colors[i] : glm::vec4(1.0f);
+        var[0] = uv.x; var[1] = uv.y;
+        var[2] = rgba.r; var[3] = rgba.g; var[4] = rgba.b; var[5] = rgba.a;
+    }
+    void fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
+        const Material& m = *material->m;
+        out.kill = 0;
+        for (int l = 0; l < kBlockLanes; ++l) {
+            glm::vec4 c = m.base_color_factor * glm::vec4(in.var[2][l], in.var[3][l], in.var[4][l], in.var[5][l]);
+            if (material->base_color) c *= material->base_color->sample(in.var[0][l], in.var[1][l], 0.0f, 0.0f, 0.0f, 0.0f);
+            out.r[l] = c.r; out.g[l] = c.g; out.b[l] = c.b;
+            out.a[l] = m.alpha_mode == AlphaMode::Blend ? c.a : 1.0f;
+            if (m.alpha_mode == AlphaMode::Mask && !(c.a >= m.alpha_cutoff)) out.kill |= 1u << l;
+        }
+    }
+};
+
 // A tap factory that watches nothing.
 struct NoTaps {
     NullObserver operator()(const SceneDraw&) const { return {}; }
@@ -147,12 +179,22 @@ private:
     void begin_pass(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out, Pass& pass);
     PbrProgram program(const FrameSettings& settings, const Pass& pass, const Mesh& mesh,
                        const BoundMaterial& bm) const;
+    // The wide varying layout: vertex colours, UV sets past 0 (needs_extended_varyings).
+    PbrProgramExt program_ext(const FrameSettings& settings, const Pass& pass, const Mesh& mesh,
+                              const BoundMaterial& bm) const;
+    template <class P>
+    P program_of(const FrameSettings& settings, const Pass& pass, const Mesh& mesh, const BoundMaterial& bm) const;
+    // A mesh of lines or points: with its material, lit when it has normals.
+    template <class Tap>
+    void submit_lines(const FrameSettings& settings, const Pass& pass, const Mesh& mesh, const BoundMaterial& bm,
+                      const SceneDraw& d, Tap& tap);
     void end_pass(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out, const Pass& pass);
 
     const Scene& scene_;
     Renderer& renderer_;
     std::vector<std::unique_ptr<Texture>> textures_;  // [image * 2 + srgb]
     std::vector<std::unique_ptr<Texture>> packed_;    // OBJ roughness + metal pairs
+    std::vector<std::unique_ptr<Texture>> views_;     // textures_ through other samplers
     std::vector<BoundMaterial> bound_;
     std::vector<std::string> warnings_;
     ShadowMaps shadow_maps_;
@@ -178,16 +220,45 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
         SceneDraw d;
         d.mesh = int(mi);
         d.first_triangle = std::uint32_t(first);
+        if (mesh.topology != Mesh::Topology::Triangles) {  // no triangles: triangle_count 0
+            d.vertex_count = std::uint32_t(mesh.positions.size());
+            d.state = draw_state(bm, s.view);
+            d.state.topology = mesh.topology == Mesh::Topology::Lines ? Topology::Lines : Topology::Points;
+            taps.push_back(make_tap(d));
+            submit_lines(s, pass, mesh, bm, d, taps.back());
+            continue;
+        }
         d.triangle_count = std::uint32_t(mesh.indices.size() / 3);
         d.vertex_count = std::uint32_t(mesh.positions.size());
         d.state = draw_state(bm, s.view);
         const std::uint64_t drawn = std::min<std::uint64_t>(d.triangle_count, triangle_limit - first);
         taps.push_back(make_tap(d));
-        renderer_.submit(program(s, pass, mesh, bm), d.vertex_count, mesh.indices.data(), std::size_t(drawn) * 3,
-                         d.state, taps.back());
+        if (needs_extended_varyings(mesh, bm))
+            renderer_.submit(program_ext(s, pass, mesh, bm), d.vertex_count, mesh.indices.data(),
+                             std::size_t(drawn) * 3, d.state, taps.back());
+        else
+            renderer_.submit(program(s, pass, mesh, bm), d.vertex_count, mesh.indices.data(), std::size_t(drawn) * 3,
+                             d.state, taps.back());
         first += d.triangle_count;
     }
     end_pass(s, fb, out, pass);
+}
+
+template <class Tap>
+void SceneRenderer::submit_lines(const FrameSettings& s, const Pass& pass, const Mesh& mesh, const BoundMaterial& bm,
+                                 const SceneDraw& d, Tap& tap) {
+    const std::size_t n = d.state.topology == Topology::Lines ? mesh.indices.size() / 2 * 2 : mesh.indices.size();
+    if (mesh.normals.empty() && (s.view == DebugView::None || s.view == DebugView::Tiles)) {
+        UnlitProgram prog;
+        prog.mesh = &mesh;
+        prog.view_proj = pass.view_proj;
+        prog.material = &bm;
+        renderer_.submit(prog, d.vertex_count, mesh.indices.data(), n, d.state, tap);
+    } else if (needs_extended_varyings(mesh, bm)) {
+        renderer_.submit(program_ext(s, pass, mesh, bm), d.vertex_count, mesh.indices.data(), n, d.state, tap);
+    } else {
+        renderer_.submit(program(s, pass, mesh, bm), d.vertex_count, mesh.indices.data(), n, d.state, tap);
+    }
 }
 
 // The background a frame with these settings clears to: settings.background

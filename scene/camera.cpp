@@ -11,6 +11,11 @@ namespace prast {
 glm::mat4 Camera::view() const { return glm::lookAt(eye, target, up); }
 
 glm::mat4 Camera::projection(float aspect) const {
+    if (orthographic) {
+        const float x = ortho_ymag * aspect;
+        return glm::ortho(-x, x, -ortho_ymag, ortho_ymag, near_plane, far_plane);
+    }
+    if (infinite_far) return glm::infinitePerspective(glm::radians(fov_y_deg), aspect, near_plane);
     return glm::perspective(glm::radians(fov_y_deg), aspect, near_plane, far_plane);
 }
 

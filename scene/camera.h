@@ -15,6 +15,11 @@ struct Camera {
     float fov_y_deg = 45.0f;
     float near_plane = 0.1f;
     float far_plane = 100.0f;
+    // A file's camera may be orthographic (half height ortho_ymag, the width
+    // from the aspect) or perspective without a far plane.
+    bool orthographic = false;
+    float ortho_ymag = 1.0f;
+    bool infinite_far = false;
 
     glm::mat4 view() const;
     glm::mat4 projection(float aspect) const;

@@ -212,7 +212,7 @@ bool FileScope::charge(std::uint64_t bytes, std::string& why) {
 }
 
 std::string FileScope::refusal(const std::string& what, const std::string& reference, const Resolved& r) const {
-    std::string line = printable(model_) + ": " + printable(what) + " '" + printable(reference) + "' refused: " +
+    std::string line = printable(model_) + ": " + printable(what) + " '" + printable(cut(reference)) + "' refused: " +
                        r.refused;
     if (r.outside) line += " (--allow-outside-paths reads it)";
     return line;

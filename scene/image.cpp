@@ -368,6 +368,46 @@ bool decode_png8(PngSource& src, int w, int h, Image& img) {
     return true;
 }
 
+// Decodes a 16-bit PNG into `samples` (tRNS expanded to an alpha channel, as
+// stb_image does), and its channel count; false with src.error set on
+// failure. For the PNGs stb_image refuses by size.
+bool decode_png16(PngSource& src, int w, int h, std::vector<std::uint16_t>& samples, int& channels) {
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &src, png_on_error, png_on_warning);
+    if (!png) {
+        std::snprintf(src.error, sizeof src.error, "out of memory");
+        return false;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (!info || setjmp(png_jmpbuf(png))) {
+        png_destroy_read_struct(&png, info ? &info : nullptr, nullptr);
+        if (!src.error[0]) std::snprintf(src.error, sizeof src.error, "out of memory");
+        return false;
+    }
+    png_set_read_fn(png, &src, png_read_memory);
+    png_set_user_limits(png, 0x7FFFFFFF, 0x7FFFFFFF);
+    png_read_info(png, info);
+    if (int(png_get_image_width(png, info)) != w || int(png_get_image_height(png, info)) != h ||
+        png_get_bit_depth(png, info) != 16)
+        png_error(png, "inconsistent image header");
+    png_set_expand(png);  // tRNS -> alpha
+    const std::uint16_t probe = 1;
+    unsigned char first = 0;
+    std::memcpy(&first, &probe, 1);
+    if (first == 1) png_set_swap(png);  // the file's big-endian samples in host order
+    const int passes = png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+    channels = png_get_channels(png, info);
+    const std::size_t stride = std::size_t(w) * std::size_t(channels) * 2;
+    if (channels < 1 || channels > 4 || png_get_rowbytes(png, info) != stride)
+        png_error(png, "unsupported pixel layout");
+    samples.resize(stride / 2 * std::size_t(h));
+    png_bytep rows = reinterpret_cast<png_bytep>(samples.data());
+    for (int pass = 0; pass < passes; ++pass)
+        for (int y = 0; y < h; ++y) png_read_row(png, rows + std::size_t(y) * stride, nullptr);
+    png_destroy_read_struct(&png, &info, nullptr);
+    return true;
+}
+
 } // namespace
 
 const float* srgb8_decode_table() {
@@ -447,6 +487,131 @@ std::string stb_unsafe(const unsigned char* data, std::size_t size) {
     return why.empty() ? why : "cannot decode JPEG image: " + why;
 }
 
+// A PNG's IHDR (ISO 15948 11.2.2), when it is the first chunk and its fields
+// are a valid combination; `channels` counts the alpha a tRNS chunk before the
+// pixel data adds (a palette's entries are RGB).
+struct PngHeader {
+    std::uint32_t width = 0, height = 0;
+    int depth = 0, colour = 0, channels = 0;
+};
+
+bool read_png_ihdr(const unsigned char* data, std::size_t size, PngHeader& out) {
+    if (!is_png(data, size) || size < 8 + 25 || be32(data + 8) != 13 || std::memcmp(data + 12, "IHDR", 4) != 0)
+        return false;
+    const unsigned char* d = data + 16;
+    PngHeader p;
+    p.width = be32(d);
+    p.height = be32(d + 4);
+    p.depth = d[8];
+    p.colour = d[9];
+    if (p.width == 0 || p.height == 0 || p.width > 0x7FFFFFFFu || p.height > 0x7FFFFFFFu) return false;
+    if (d[10] != 0 || d[11] != 0 || d[12] > 1) return false;  // compression, filter, interlace methods
+    const bool small_depth = p.depth == 1 || p.depth == 2 || p.depth == 4;
+    switch (p.colour) {
+    case 0: p.channels = 1; if (!small_depth && p.depth != 8 && p.depth != 16) return false; break;
+    case 3: p.channels = 3; if (!small_depth && p.depth != 8) return false; break;
+    case 2: case 4: case 6:
+        p.channels = p.colour == 2 ? 3 : p.colour == 4 ? 2 : 4;
+        if (p.depth != 8 && p.depth != 16) return false;
+        break;
+    default: return false;
+    }
+    for (std::size_t pos = 33; pos + 12 <= size;) {
+        const std::uint32_t len = be32(data + pos);
+        const unsigned char* type = data + pos + 4;
+        if (std::memcmp(type, "IDAT", 4) == 0) break;
+        if (std::memcmp(type, "tRNS", 4) == 0 && (p.colour == 0 || p.colour == 2 || p.colour == 3)) {
+            ++p.channels;
+            break;
+        }
+        if (len > size - pos - 12) break;
+        pos += 12 + std::size_t(len);
+    }
+    out = p;
+    return true;
+}
+
+// True when stb_image 2.27's header scan refuses this PNG by its size alone:
+// a side beyond kMaxStbImageSide, or more than 2^30 samples (a palette
+// counted as 4).
+bool stb_refuses_png_size(const PngHeader& p) {
+    if (p.width > std::uint32_t(kMaxStbImageSide) || p.height > std::uint32_t(kMaxStbImageSide)) return true;
+    const std::uint32_t samples = p.colour == 3 ? 4 : std::uint32_t(p.colour & 2 ? 3 : 1) + (p.colour & 4 ? 1 : 0);
+    return (std::uint32_t(1) << 30) / p.width / samples < p.height;
+}
+
+// What an image's header says, checked as decode_image() needs it.
+struct ImageHeader {
+    int width = 0, height = 0, channels = 0;
+    bool hdr = false, sixteen_bit = false;
+    bool png_by_ihdr = false;  // read from the IHDR: stb_image refuses its size, libpng decodes it
+};
+
+// "" with `hd` filled when the bytes (all of a file of `file_size` bytes, or
+// its first ones) have a header that decode_image() goes on to decode; else
+// the reason, the message after "NAME: ". Every value stbi_info() gives is
+// checked before use: stb 2.27 returns a top-down BMP's height negative, and
+// a Radiance or PNM size as whatever its integer parse made of the text.
+std::string read_image_header(const unsigned char* data, std::size_t size, std::uint64_t file_size,
+                              ImageHeader& hd) {
+    const int len = int(std::min<std::size_t>(size, std::size_t(INT_MAX)));
+    const char* format = sniff_format(data, size);
+    int w = 0, h = 0, comp = 0;
+    if (!stbi_info_from_memory(data, len, &w, &h, &comp)) {
+        const std::string reason = stbi_reason();
+        PngHeader png;
+        if (read_png_ihdr(data, size, png) && stb_refuses_png_size(png)) {
+            const std::int64_t texels = std::int64_t(png.width) * std::int64_t(png.height);
+            if (texels > kMaxImageTexels)
+                return "image too large: " + std::to_string(png.width) + "x" + std::to_string(png.height) + " = " +
+                       std::to_string(texels) + " texels, more than the limit of " + std::to_string(kMaxImageTexels) +
+                       " (2^28)";
+            hd.width = int(png.width);
+            hd.height = int(png.height);
+            hd.channels = png.channels;
+            hd.sixteen_bit = png.depth == 16;
+            hd.png_by_ihdr = true;
+        } else {
+            if (!format) return "not an image file stb_image can read (" + reason + ")";
+            return std::string("cannot decode ") + format + " image: " +
+                   (reason == "unknown image type" ? "corrupt or truncated header" : reason);
+        }
+    } else {
+        // A BMP with a negative height stores its rows top-down; stbi_load
+        // puts row 0 on top for either order.
+        if (format && std::strcmp(format, "BMP") == 0 && h < 0 && h != INT_MIN) h = -h;
+        if (w <= 0 || h <= 0) {
+            const std::string size_text = "(" + std::to_string(w) + "x" + std::to_string(h) + ")";
+            if (w == 0 || h == 0) return "image has zero size " + size_text;
+            return "bad image size " + size_text + " in the header";
+        }
+        if (comp < 1 || comp > 4) return "unsupported channel count " + std::to_string(comp) + " in the header";
+        hd.width = w;
+        hd.height = h;
+        hd.channels = comp;
+        hd.hdr = stbi_is_hdr_from_memory(data, len) != 0;
+        hd.sixteen_bit = stbi_is_16_bit_from_memory(data, len) != 0;
+    }
+    w = hd.width;
+    h = hd.height;
+    const std::int64_t texels = std::int64_t(w) * std::int64_t(h);
+    if (texels > kMaxImageTexels)
+        return "image too large: " + std::to_string(w) + "x" + std::to_string(h) + " = " + std::to_string(texels) +
+               " texels, more than the limit of " + std::to_string(kMaxImageTexels) + " (2^28)";
+    if (!hd.png_by_ihdr && (w > kMaxStbImageSide || h > kMaxStbImageSide))
+        return std::string("image too large: ") + std::to_string(w) + "x" + std::to_string(h) + ", more than " +
+               std::to_string(kMaxStbImageSide) + " pixels a side (" + (format ? format : "this format") +
+               " images are decoded by stb_image)";
+    // A JPEG needs at least a bit per 8x8 block (a progressive DC scan), so
+    // no file holds more than 512 texels a byte; a small file that claims
+    // more would keep stb_image decoding made-up data for seconds.
+    if (looks_like_jpeg(data, size) && std::uint64_t(texels) > std::uint64_t(kMaxJpegTexelsPerByte) * file_size)
+        return "cannot decode JPEG image: " + std::to_string(w) + "x" + std::to_string(h) + " texels from only " +
+               std::to_string(file_size) + " bytes (a JPEG holds at most " + std::to_string(kMaxJpegTexelsPerByte) +
+               " texels a byte)";
+    return "";
+}
+
 } // namespace
 
 Image decode_image(const ImageSource& src, bool srgb) {
@@ -472,30 +637,11 @@ Image decode_image(const ImageSource& src, bool srgb) {
     if (!unsafe.empty()) throw LoadError(name + ": " + unsafe);
 
     // Check the header before decoding anything: refuse absurd sizes up front.
-    int w = 0, h = 0, comp = 0;
-    if (!stbi_info_from_memory(data, len, &w, &h, &comp)) {
-        const char* format = sniff_format(data, bytes->size());
-        const std::string reason = stbi_reason();
-        if (!format) throw LoadError(name + ": not an image file stb_image can read (" + reason + ")");
-        throw LoadError(name + ": cannot decode " + format + " image: " +
-                        (reason == "unknown image type" ? "corrupt or truncated header" : reason));
-    }
-    if (w <= 0 || h <= 0)
-        throw LoadError(name + ": image has zero size (" + std::to_string(w) + "x" +
-                        std::to_string(h) + ")");
+    ImageHeader header;
+    const std::string refused = read_image_header(data, bytes->size(), bytes->size(), header);
+    if (!refused.empty()) throw LoadError(name + ": " + refused);
+    const int w = header.width, h = header.height;
     const std::int64_t texels = std::int64_t(w) * std::int64_t(h);
-    if (texels > kMaxImageTexels)
-        throw LoadError(name + ": image too large: " + std::to_string(w) + "x" +
-                        std::to_string(h) + " = " + std::to_string(texels) +
-                        " texels, more than the limit of " + std::to_string(kMaxImageTexels) +
-                        " (2^28)");
-    // A JPEG needs at least a bit per 8x8 block (a progressive DC scan), so
-    // no file holds more than 512 texels a byte; a small file that claims
-    // more would keep stb_image decoding made-up data for seconds.
-    if (looks_like_jpeg(data, bytes->size()) && texels > kMaxJpegTexelsPerByte * std::int64_t(bytes->size()))
-        throw LoadError(name + ": cannot decode JPEG image: " + std::to_string(w) + "x" + std::to_string(h) +
-                        " texels from only " + std::to_string(bytes->size()) + " bytes (a JPEG holds at most " +
-                        std::to_string(kMaxJpegTexelsPerByte) + " texels a byte)");
 
     if (is_png(data, bytes->size())) {
         const std::string shortfall = png_data_shortfall(data, bytes->size(), w, h);
@@ -521,13 +667,26 @@ Image decode_image(const ImageSource& src, bool srgb) {
     };
     const std::size_t count = std::size_t(texels);
     const auto unit = [](float c) { return c; };
-    if (stbi_is_hdr_from_memory(data, len)) {
+    if (header.png_by_ihdr && header.sixteen_bit) {
+        std::vector<std::uint16_t> values;
+        int channels = 0;
+        PngSource png{data, bytes->size(), 0, {0}};
+        if (!decode_png16(png, w, h, values, channels))
+            throw LoadError(name + ": cannot decode PNG image: " + png.error);
+        img.width = w;
+        img.height = h;
+        img.rgba.resize(count * 4);
+        const auto linear = [](stbi_us c) { return float(c) / 65535.0f; };
+        const auto decode = [](stbi_us c) { return srgb_to_linear(float(c) / 65535.0f); };
+        if (srgb) expand_to_rgba(values.data(), channels, count, img.rgba.data(), decode, linear);
+        else expand_to_rgba(values.data(), channels, count, img.rgba.data(), linear, linear);
+    } else if (header.hdr) {
         // Radiance HDR: linear floats, kept as is whatever `srgb` says.
         std::unique_ptr<float, StbiFree> px(stbi_loadf_from_memory(data, len, &dw, &dh, &dcomp, 0));
         check(px.get());
         img.rgba.resize(count * 4);
         expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), unit, unit);
-    } else if (stbi_is_16_bit_from_memory(data, len)) {
+    } else if (header.sixteen_bit) {
         std::unique_ptr<stbi_us, StbiFree> px(stbi_load_16_from_memory(data, len, &dw, &dh, &dcomp, 0));
         check(px.get());
         img.rgba.resize(count * 4);
@@ -564,6 +723,7 @@ bool image_dimensions(const ImageSource& src, int& width, int& height, int* byte
     constexpr std::size_t kHeaderBytes = std::size_t(1) << 20;
     std::vector<unsigned char> head;
     const std::vector<unsigned char>* bytes = &src.bytes;
+    std::uint64_t file_size = src.bytes.size();
     if (src.bytes.empty()) {
         if (src.path.empty()) return false;
         std::uint64_t size = 0;
@@ -573,6 +733,7 @@ bool image_dimensions(const ImageSource& src, int& width, int& height, int* byte
         } catch (const LoadError&) {
             return false;
         }
+        file_size = size;
         head.resize(std::size_t(std::min<std::uint64_t>(size, kHeaderBytes)));
         std::size_t got = 0;
         while (got < head.size()) {
@@ -587,14 +748,22 @@ bool image_dimensions(const ImageSource& src, int& width, int& height, int* byte
     }
     if (bytes->empty() || bytes->size() > std::size_t(INT_MAX)) return false;
     const stbi_uc* data = bytes->data();
-    const int len = int(bytes->size());
     // stbi_info reads a JPEG's tables (guarded); a Radiance header alone is
     // safe, and its pixels are beyond the prefix read here.
     if (!looks_like_hdr(data, bytes->size()) && !stb_unsafe(data, bytes->size()).empty()) return false;
-    int comp = 0;
-    if (!stbi_info_from_memory(data, len, &width, &height, &comp)) return false;
-    if (bytes_per_texel)
-        *bytes_per_texel = stbi_is_hdr_from_memory(data, len) || stbi_is_16_bit_from_memory(data, len) ? 16 : comp;
+    // Only a size the decoder goes on to decode: one it refuses is a warning
+    // when decoded, never part of the plan.
+    ImageHeader header;
+    if (!read_image_header(data, bytes->size(), file_size, header).empty()) return false;
+    // A small PNG whose header claims more pixels than its data can hold is
+    // refused as well (a model may name many); a large one is only read here
+    // as far as its header.
+    if (bytes->size() == file_size && is_png(data, bytes->size()) &&
+        !png_data_shortfall(data, bytes->size(), header.width, header.height).empty())
+        return false;
+    width = header.width;
+    height = header.height;
+    if (bytes_per_texel) *bytes_per_texel = header.hdr || header.sixteen_bit ? 16 : header.channels;
     return true;
 }
 

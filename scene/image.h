@@ -3,9 +3,10 @@
 // the image is a colour map (base colour, emissive; conventions.md
 // "Textures"), or linear float RGBA for HDR files, 16-bit files and the
 // procedural images of the built-in scene. Decoding PNG, JPEG and Radiance HDR
-// files (or embedded bytes). Row 0 is the top row of the file; nothing is
-// flipped. 8-bit values become linear floats only when sampled, through the
-// 256-entry tables below, so that a texture costs its file's size in memory.
+// files (or embedded bytes). Row 0 is the top row of the image as shown (a
+// BMP's rows come out top first whichever way the file stores them). 8-bit
+// values become linear floats only when sampled, through the 256-entry tables
+// below, so that a texture costs its file's size in memory.
 #pragma once
 
 #include <cstddef>
@@ -67,6 +68,11 @@ struct Image {
 // texels is 4 GiB as float RGBA, far beyond any sane texture.
 constexpr std::int64_t kMaxImageTexels = std::int64_t(1) << 28;
 
+// The longest side stb_image decodes (STBI_MAX_DIMENSIONS in
+// third_party_impl/stb_impl.cpp). PNGs are decoded by libpng, which has no
+// such limit: a PNG may have any shape within kMaxImageTexels.
+constexpr int kMaxStbImageSide = 1 << 15;
+
 // Decodes src.bytes when not empty, else the file src.path (PNG, JPEG, HDR and
 // whatever else stb_image reads). 8-bit files keep their bytes and channel
 // count, marked sRGB when `srgb` (Image::at() and the texture sampler decode
@@ -80,8 +86,10 @@ Image decode_image(const ImageSource& src, bool srgb);
 // The width and height in an image's header, read without decoding (a file
 // only as far as its header, through scene/file_access.h), and the bytes a
 // decoded texel takes (the channel count for 8-bit files, 16 for float RGBA:
-// HDR and 16-bit); false when the header cannot be read. For planning memory
-// before decoding.
+// HDR and 16-bit); false when the header cannot be read or gives a size that
+// decode_image() refuses (zero, negative, beyond a side or texel limit), so
+// that planning memory before decoding never counts an image that will not
+// be decoded.
 bool image_dimensions(const ImageSource& src, int& width, int& height, int* bytes_per_texel = nullptr);
 
 } // namespace prast

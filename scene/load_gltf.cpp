@@ -10,7 +10,8 @@
 //  - an image in a bufferView is handed to the image callback without checking
 //    byteOffset/byteLength against the buffer: the callback ignores those bytes
 //    and they are copied here after a bounds check.
-// Images are never decoded here (tinygltf is built without stb_image), and
+// Images are not decoded here (tinygltf is built without stb_image) except
+// the textures of a specular-glossiness material, converted texel by texel; and
 // tinygltf never opens an image file (TINYGLTF_NO_EXTERNAL_IMAGE): image uris
 // are resolved here, buffer uris through file-system callbacks, both by the
 // model's FileScope (scene/file_access.h), so no uri leaves the model's folder
@@ -18,6 +19,7 @@
 #include "scene/load_scene.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -31,6 +33,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE
@@ -38,7 +42,10 @@
 #define TINYGLTF_NO_INCLUDE_STB_IMAGE_WRITE
 #include <tiny_gltf.h>
 
+#include "scene/animation.h"
 #include "scene/file_access.h"
+#include "scene/image.h"
+#include "scene/gltf_graph.h"
 #include "scene/messages.h"
 
 namespace prast {
@@ -52,6 +59,8 @@ namespace {
 constexpr int kMaxJsonDepth = 256;
 // No accessor may claim more elements than this (2^31 - 1).
 constexpr std::size_t kMaxAccessorCount = 0x7fffffff;
+// tinygltf's own messages quote the file: a line of theirs is cut to this.
+constexpr std::size_t kMaxLineChars = 2 * kMaxShownChars;
 
 // ---- Callbacks handed to tinygltf
 
@@ -152,23 +161,113 @@ std::size_t check_glb(const std::vector<unsigned char>& b, const std::string& pa
     return length;
 }
 
-// Refuses JSON nested deeper than kMaxJsonDepth (strings are skipped).
-void check_json_depth(const char* s, std::size_t n, const std::string& path) {
+// True when the JSON string token s[0, n) (quotes included) is the key
+// `name`, however it is escaped.
+bool key_is(const char* s, std::size_t n, const std::string& name) {
+    if (std::memchr(s, '\\', n) == nullptr)
+        return n == name.size() + 2 && std::memcmp(s + 1, name.data(), name.size()) == 0;
+    const nlohmann::json decoded = nlohmann::json::parse(s, s + n, nullptr, false);
+    return decoded.is_string() && decoded.get<std::string>() == name;
+}
+
+// What is checked before tinygltf loads any buffer, from the top-level object:
+// the "extensionsRequired" array as tinygltf will read it (a non-string entry
+// is ""), and the texts of the "asset" object and the "samplers" array (the
+// samplers' enums as the file writes them: tinygltf keeps the low 32 bits of
+// an integer).
+struct TopLevel {
+    std::vector<std::string> required;
+    std::string asset, samplers;  // JSON text, empty when absent
+};
+
+// Refuses JSON nested deeper than kMaxJsonDepth (strings are skipped), and
+// returns the TopLevel parts; none when the text does not even balance its
+// brackets. The last of repeated keys counts, as in tinygltf's parser.
+TopLevel check_json(const char* s, std::size_t n, const std::string& path) {
+    static const std::string kKeys[] = {"extensionsRequired", "asset", "samplers"};
+    constexpr int kNone = -1;
     int depth = 0;
     bool in_string = false;
+    std::size_t string_begin = 0, key_begin = 0, key_end = 0;  // the last string closed in the root object
+    int key_next = kNone;                                      // after one of kKeys and ':'
+    int open_key = kNone;                                      // the kKeys value being scanned
+    std::size_t value_begin = 0;
+    std::pair<std::size_t, std::size_t> spans[3] = {};
     for (std::size_t i = 0; i < n; ++i) {
         const char c = s[i];
         if (in_string) {
-            if (c == '\\') ++i;
-            else if (c == '"') in_string = false;
+            if (c == '\\') {
+                ++i;
+            } else if (c == '"') {
+                in_string = false;
+                if (depth == 1) key_begin = string_begin, key_end = i + 1;
+            }
         } else if (c == '"') {
             in_string = true;
+            string_begin = i;
+            key_next = kNone;
+        } else if (c == ':') {
+            key_next = kNone;
+            if (depth == 1 && key_end > key_begin)
+                for (int k = 0; k < 3; ++k)
+                    if (key_is(s + key_begin, key_end - key_begin, kKeys[k])) key_next = k;
         } else if (c == '{' || c == '[') {
             if (++depth > kMaxJsonDepth) throw LoadError(path + ": JSON nested too deeply");
+            // extensionsRequired and samplers are arrays, asset an object.
+            if (depth == 2 && key_next != kNone && (c == '[') == (key_next != 1)) {
+                open_key = key_next;
+                value_begin = i;
+            }
+            key_next = kNone;
         } else if (c == '}' || c == ']') {
+            if (depth == 2 && open_key != kNone) {
+                spans[open_key] = {value_begin, i + 1};
+                open_key = kNone;
+            }
             --depth;
+        } else if (c != ' ' && c != '\t' && c != '\n' && c != '\r') {
+            key_next = kNone;
         }
     }
+    TopLevel top;
+    if (in_string || depth != 0) return top;
+    if (spans[1].second > 0) top.asset.assign(s + spans[1].first, s + spans[1].second);
+    if (spans[2].second > 0) top.samplers.assign(s + spans[2].first, s + spans[2].second);
+    if (spans[0].second == 0) return top;
+    const nlohmann::json array = nlohmann::json::parse(s + spans[0].first, s + spans[0].second, nullptr, false);
+    if (!array.is_array()) return top;
+    for (const nlohmann::json& e : array) top.required.push_back(e.is_string() ? e.get<std::string>() : std::string());
+    return top;
+}
+
+// The extensions prast implements: a file may require these (and only these).
+// Others it uses optionally are ignored with a warning where they appear.
+bool implemented_extension(const std::string& ext) {
+    static const char* const kImplemented[] = {
+        "KHR_lights_punctual",              // spot lights drawn as point lights, with a warning
+        "KHR_materials_emissive_strength",
+        "KHR_materials_ior",
+        "KHR_materials_pbrSpecularGlossiness",  // converted to metal-rough at load
+        "KHR_mesh_quantization",
+    };
+    for (const char* e : kImplemented)
+        if (ext == e) return true;
+    return false;
+}
+
+// A glTF version string "MAJOR.MINOR" (glTF 2.0, "Asset": each a decimal of
+// one to nine digits without leading zeros); false when `s` is not one.
+bool parse_version(const std::string& s, unsigned long& major, unsigned long& minor) {
+    const std::size_t dot = s.find('.');
+    if (dot == std::string::npos) return false;
+    const auto number = [](const std::string& part, unsigned long& out) {
+        if (part.empty() || part.size() > 9 || (part.size() > 1 && part[0] == '0')) return false;
+        for (char ch : part)
+            if (ch < '0' || ch > '9') return false;
+        out = std::stoul(part);
+        return true;
+    };
+    return number(s.substr(0, dot), major) && number(s.substr(dot + 1), minor);
 }
 
 std::string first_line(const std::string& s, const char* fallback) {
@@ -257,6 +356,65 @@ bool finite_values(const std::vector<double>& v) {
     return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
 }
 
+// Converted specular-glossiness textures are float RGBA, 16 bytes a texel:
+// at most a 2048 x 2048 texture's worth each.
+constexpr std::int64_t kMaxBakeTexels = std::int64_t(1) << 22;
+
+// A metal-rough material (prast's BRDF, conventions.md "Shading": F0 =
+// mix(f0(ior), albedo, metallic), diffuse = (1 - F) (1 - metallic) albedo,
+// alpha = roughness^2) for specular-glossiness values (the extension: F0 =
+// specular, diffuse = (1 - F) c_diff with c_diff = diffuse (1 - max(specular)),
+// alpha = (1 - glossiness)^2).
+struct MetalRough {
+    glm::dvec3 base{1.0};
+    double metallic = 0.0, roughness = 1.0, ior = 1.5;
+};
+
+// roughness = 1 - glossiness always (the same alpha). The rest:
+//  - no diffuse light (c_diff = 0): metallic 1, base = specular: exact;
+//  - a grey specular s < 1 and `exact_ior`: metallic 0, base = c_diff and
+//    ior = (1 + sqrt(s)) / (1 - sqrt(s)), so that f0(ior) = s: exact;
+//  - otherwise (a coloured specular over a diffuse colour) no metal-rough
+//    material matches: ior 1.5 (f0 0.04), and metallic is solved on perceived
+//    brightness b(c) = sqrt(0.299 r^2 + 0.587 g^2 + 0.114 b^2) as the
+//    extension's conversion example does, with prast's diffuse term:
+//    0.04 m^2 + (b(c_diff) + b(S) - 0.08) m + (0.04 - b(S)) = 0 (0 when
+//    b(S) < 0.04); base = mix(c_diff / (1 - m), (S - 0.04 (1 - m)) / m, m^2),
+//    clamped to [0, 1]. Exact only where the two agree (S = 0.04 grey).
+MetalRough specular_glossiness_to_metal_rough(const glm::dvec3& diffuse, const glm::dvec3& specular,
+                                              double glossiness, bool exact_ior) {
+    MetalRough out;
+    out.roughness = std::clamp(1.0 - glossiness, 0.0, 1.0);
+    const double strongest = std::max({specular.r, specular.g, specular.b});
+    const glm::dvec3 c_diff = diffuse * (1.0 - strongest);
+    if (c_diff == glm::dvec3(0.0)) {
+        out.metallic = 1.0;
+        out.base = specular;
+        return out;
+    }
+    if (exact_ior && specular.r == specular.g && specular.g == specular.b && strongest < 1.0) {
+        const double r = std::sqrt(strongest);
+        out.ior = (1.0 + r) / (1.0 - r);
+        out.base = c_diff;
+        return out;
+    }
+    constexpr double kF0 = 0.04;
+    const auto brightness = [](const glm::dvec3& c) {
+        return std::sqrt(0.299 * c.r * c.r + 0.587 * c.g * c.g + 0.114 * c.b * c.b);
+    };
+    const double bd = brightness(c_diff), bs = brightness(specular);
+    double m = 0.0;
+    if (bs >= kF0) {
+        const double a = kF0, b = bd + bs - 2.0 * kF0, c = kF0 - bs;
+        m = std::clamp((-b + std::sqrt(std::max(b * b - 4.0 * a * c, 0.0))) / (2.0 * a), 0.0, 1.0);
+    }
+    const glm::dvec3 from_diffuse = c_diff / std::max(1.0 - m, 1e-6);
+    const glm::dvec3 from_specular = (specular - glm::dvec3(kF0 * (1.0 - m))) / std::max(m, 1e-6);
+    out.metallic = m;
+    out.base = glm::clamp(glm::mix(from_diffuse, from_specular, m * m), 0.0, 1.0);
+    return out;
+}
+
 Wrap wrap_mode(int mode, bool& known) {
     known = true;
     switch (mode) {
@@ -279,13 +437,26 @@ public:
         for (std::size_t i = 0; i < model_.materials.size(); ++i)
             scene_.materials.push_back(convert_material(model_.materials[i], i));
         traverse_scene();
+        GltfGraphContext graph{shown_, elements_, zero_filled_, [this](const std::string& w) { warn(w); }};
+        read_gltf_graph(model_, scene_, graph);  // skins, morph targets, animations, cameras
         scene_.warnings = log_.lines();
         detail::finish_scene(scene_, path_);
+        pose_scene(scene_, 0.0, kNoAnimation);  // the rest pose: skins and default morph weights applied
         return std::move(scene_);
     }
 
 private:
     static constexpr int kNotYet = -2;
+
+    // The texCoord values as the file writes them, by "material/parent/key";
+    // read only for file_texcoord().
+    bool texcoords_read_ = false;
+    std::map<std::string, std::string> texcoords_;
+
+    // The "samplers" array's text from check_json, parsed on first use.
+    std::string samplers_json_;
+    bool samplers_parsed_ = false;
+    nlohmann::json raw_samplers_;
 
     // Messages hold names from the file: escaped here, once for all.
     [[noreturn]] void fail(const std::string& why) const { throw LoadError(shown_ + ": " + printable(why)); }
@@ -319,17 +490,17 @@ private:
         bool ok = false;
         if (glb) {
             const std::size_t length = check_glb(bytes, shown_);
-            check_json_depth(reinterpret_cast<const char*>(&bytes[20]), le32(&bytes[12]), shown_);
+            check_top_level(check_json(reinterpret_cast<const char*>(&bytes[20]), le32(&bytes[12]), shown_));
             ok = ctx.LoadBinaryFromMemory(&model_, &err, &warnings, bytes.data(),
                                           static_cast<unsigned int>(length), base_dir_);
         } else {
-            check_json_depth(reinterpret_cast<const char*>(bytes.data()), bytes.size(), shown_);
+            check_top_level(check_json(reinterpret_cast<const char*>(bytes.data()), bytes.size(), shown_));
             ok = ctx.LoadASCIIFromString(&model_, &err, &warnings,
                                          reinterpret_cast<const char*>(bytes.data()),
                                          static_cast<unsigned int>(bytes.size()), base_dir_);
         }
         if (!ok && !fs_state.refused.empty()) throw LoadError(fs_state.refused);
-        if (!ok) fail(first_line(err, "cannot parse glTF"));
+        if (!ok) fail(cut(first_line(err, "cannot parse glTF"), kMaxLineChars));
 
         // tinygltf's warnings, except the missing images that image_for() reports.
         std::size_t start = 0;
@@ -341,21 +512,40 @@ private:
             if (line.empty() || line.rfind("File not found", 0) == 0 ||
                 line.rfind("Failed to load external 'uri' for image", 0) == 0)
                 continue;
-            warn_once(line);
+            warn_once(cut(line, kMaxLineChars));
         }
     }
 
+    // Before tinygltf reads anything else: a model that needs what is not
+    // supported (a newer glTF, an extension) is refused naming that, not for
+    // what its buffers lack (a compressed model's fallback buffer has no uri).
+    void check_top_level(const TopLevel& top) {
+        check_min_version(top.asset);
+        for (const std::string& ext : top.required)
+            if (!implemented_extension(ext)) fail("required extension " + cut(ext) + " is not supported");
+        samplers_json_ = top.samplers;
+    }
+
+    // glTF 2.0, "Asset": a client MUST support asset.minVersion to load the
+    // asset; prast implements 2.0.
+    void check_min_version(const std::string& asset_text) const {
+        if (asset_text.empty()) return;
+        const nlohmann::json asset = nlohmann::json::parse(asset_text, nullptr, false);
+        if (!asset.is_object()) return;  // tinygltf names the problem
+        const auto it = asset.find("minVersion");
+        if (it == asset.end()) return;
+        if (!it->is_string()) fail("asset.minVersion is not a version string");
+        const std::string v = it->get<std::string>();
+        unsigned long major = 0, minor = 0;
+        if (!parse_version(v, major, minor))
+            fail("asset.minVersion '" + cut(v) + "' is not a glTF version (MAJOR.MINOR)");
+        if (major > 2 || (major == 2 && minor > 0))
+            fail("asset.minVersion " + v + " is required, prast loads glTF 2.0");
+    }
+
     void check_required_extensions() {
-        for (const std::string& ext : model_.extensionsRequired) {
-            if (ext == "KHR_lights_punctual" || ext == "KHR_mesh_quantization" ||
-                ext == "KHR_materials_emissive_strength" || ext == "KHR_materials_ior")
-                continue;
-            if (ext.rfind("KHR_materials_", 0) == 0 || ext == "KHR_texture_transform") {
-                warn("required extension " + ext + " is not supported, ignored");
-                continue;
-            }
-            fail("required extension " + ext + " is not supported");
-        }
+        for (const std::string& ext : model_.extensionsRequired)
+            if (!implemented_extension(ext)) fail("required extension " + cut(ext) + " is not supported");
     }
 
     // ---- Accessors: every offset, stride and count checked before reading
@@ -489,7 +679,7 @@ private:
         } else if (!img.uri.empty()) {
             const FileScope::Resolved where = scope_.resolve(scope_.root(), decode_uri(img.uri));
             if (!where.ok()) {
-                if (where.missing) warn("image " + std::to_string(i) + " '" + img.uri + "' not found, texture ignored");
+                if (where.missing) warn("image " + std::to_string(i) + " '" + cut(img.uri) + "' not found, texture ignored");
                 else log_.add(scope_.refusal("image " + std::to_string(i), img.uri, where) + ", texture ignored");
                 return -1;
             }
@@ -513,19 +703,98 @@ private:
         return mapped;
     }
 
+    // The integer at materials[material].{parent.}key.texCoord as the file
+    // writes it: tinygltf keeps the low 32 bits of an integer as an int, so
+    // 2^31 would print as -2^31. The model's JSON is read and parsed again
+    // for it, only for this warning and once: every material's values are
+    // kept as text and the parsed document dropped. `fallback` when it cannot
+    // be read.
+    std::string file_texcoord(std::size_t material, const char* parent, const char* key, int fallback) {
+        if (!texcoords_read_) {
+            texcoords_read_ = true;
+            try {
+                read_texcoords();
+            } catch (const std::exception&) {
+                texcoords_.clear();
+            }
+        }
+        const auto it = texcoords_.find(std::to_string(material) + "/" + (parent ? parent : "") + "/" + key);
+        return it != texcoords_.end() ? it->second : std::to_string(fallback);
+    }
+
+    void read_texcoords() {
+        std::uint64_t size = 0;
+        const int fd = open_regular_file(path_, "", size);
+        struct Closer {
+            int fd;
+            ~Closer() { ::close(fd); }
+        } closer{fd};
+        const auto read_at = [&](std::uint64_t offset, std::size_t n) {
+            std::string out(n, '\0');
+            std::size_t got = 0;
+            while (got < n) {
+                const ssize_t r = ::pread(fd, &out[got], n - got, off_t(offset + got));
+                if (r < 0 && errno == EINTR) continue;
+                if (r <= 0) break;
+                got += std::size_t(r);
+            }
+            out.resize(got);
+            return out;
+        };
+        if (size > detail::kMaxFileBytes) return;
+        // Of a .glb only its JSON chunk (checked when the model was parsed).
+        std::string text = read_at(0, std::size_t(std::min<std::uint64_t>(size, 20)));
+        if (text.size() == 20 && text.compare(0, 4, "glTF") == 0)
+            text = read_at(20, std::size_t(std::min<std::uint64_t>(
+                                   le32(reinterpret_cast<const unsigned char*>(&text[12])), size - 20)));
+        else
+            text = read_at(0, std::size_t(size));
+        const nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
+        text = {};
+        const auto materials = doc.is_object() ? doc.find("materials") : doc.end();
+        if (!doc.is_object() || materials == doc.end() || !materials->is_array()) return;
+        const auto integer = [](const nlohmann::json& v) -> std::string {
+            if (v.is_number_unsigned()) return std::to_string(v.get<std::uint64_t>());
+            if (v.is_number_integer()) return std::to_string(v.get<std::int64_t>());
+            return "";
+        };
+        const auto member = [](const nlohmann::json& v, const char* name) -> const nlohmann::json* {
+            if (!v.is_object()) return nullptr;
+            const auto it = v.find(name);
+            return it != v.end() ? &*it : nullptr;
+        };
+        for (std::size_t i = 0; i < materials->size(); ++i) {
+            const nlohmann::json& m = (*materials)[i];
+            for (const char* parent : {"", "pbrMetallicRoughness"}) {
+                const nlohmann::json* base = *parent ? member(m, parent) : &m;
+                if (!base) continue;
+                for (const char* key : {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
+                                        "occlusionTexture", "emissiveTexture"}) {
+                    const nlohmann::json* info = member(*base, key);
+                    const nlohmann::json* tc = info ? member(*info, "texCoord") : nullptr;
+                    const std::string value = tc ? integer(*tc) : "";
+                    if (!value.empty()) texcoords_[std::to_string(i) + "/" + parent + "/" + key] = value;
+                }
+            }
+        }
+    }
+
     TextureRef texture(int index, int texcoord, const tinygltf::ExtensionMap& extensions,
-                       const std::string& what) {
+                       const std::string& what, std::size_t material, const char* parent, const char* key) {
         TextureRef ref;
         if (index < 0) return ref;
         if (std::size_t(index) >= model_.textures.size()) {
             warn(what + ": texture " + std::to_string(index) + " out of range, ignored");
             return ref;
         }
-        if (texcoord != 0) {
-            warn(what + " uses TEXCOORD_" + std::to_string(texcoord) +
-                 " (only TEXCOORD_0 is supported), ignored");
+        // tinygltf keeps the low 32 bits: a set it reads as 1 is taken only when the file says 1.
+        if (texcoord < 0 || texcoord >= kMaxUvSets ||
+            (texcoord != 0 && file_texcoord(material, parent, key, texcoord) != std::to_string(texcoord))) {
+            warn(what + " uses TEXCOORD_" + file_texcoord(material, parent, key, texcoord) +
+                 " (only TEXCOORD_0 and TEXCOORD_1 are supported), ignored");
             return ref;
         }
+        ref.texcoord = texcoord;
         if (extensions.count("KHR_texture_transform"))
             warn(what + ": KHR_texture_transform ignored");
         const tinygltf::Texture& tex = model_.textures[std::size_t(index)];
@@ -538,20 +807,93 @@ private:
             if (std::size_t(tex.sampler) >= model_.samplers.size()) {
                 warn(what + ": sampler " + std::to_string(tex.sampler) + " out of range, REPEAT used");
             } else {
-                const tinygltf::Sampler& s = model_.samplers[std::size_t(tex.sampler)];
+                const std::size_t si = std::size_t(tex.sampler);
+                const tinygltf::Sampler& s = model_.samplers[si];
+                const nlohmann::json* raw = raw_sampler(si);
                 bool known_s = true, known_t = true;
                 ref.wrap_s = wrap_mode(s.wrapS, known_s);
                 ref.wrap_t = wrap_mode(s.wrapT, known_t);
+                known_s = known_s && as_written(raw, "wrapS", s.wrapS);
+                known_t = known_t && as_written(raw, "wrapT", s.wrapT);
                 if (!known_s || !known_t) warn(what + ": unknown wrap mode, REPEAT used");
+                ref.mag_filter = mag_filter(si, s.magFilter, raw);
+                ref.min_filter = min_filter(si, s.minFilter, raw);
             }
         }
         return ref;
     }
 
+    // ---- Samplers
+
+    // Sampler i as the file writes it (check_json kept the array's text), or
+    // null when that text is not the array tinygltf read.
+    const nlohmann::json* raw_sampler(std::size_t i) {
+        if (!samplers_parsed_) {
+            samplers_parsed_ = true;
+            if (!samplers_json_.empty()) raw_samplers_ = nlohmann::json::parse(samplers_json_, nullptr, false);
+            samplers_json_ = {};
+            if (!raw_samplers_.is_array() || raw_samplers_.size() != model_.samplers.size()) raw_samplers_ = {};
+        }
+        if (!raw_samplers_.is_array() || i >= raw_samplers_.size() || !raw_samplers_[i].is_object()) return nullptr;
+        return &raw_samplers_[i];
+    }
+
+    // False when the file's `key` is an integer tinygltf wrapped into `value`.
+    static bool as_written(const nlohmann::json* raw, const char* key, int value) {
+        if (!raw) return true;
+        const auto it = raw->find(key);
+        if (it == raw->end() || !(it->is_number_integer() || it->is_number_unsigned())) return true;
+        if (it->is_number_unsigned()) return it->get<std::uint64_t>() == std::uint64_t(std::int64_t(value));
+        return it->get<std::int64_t>() == value;
+    }
+
+    // A filter enum: tinygltf's `value` (-1: absent) checked against what
+    // the file writes (`raw`, when known); -1 when absent, kBadEnum when the
+    // file's value is no integer tinygltf read as it is. `shown`: the value
+    // as the file writes it, for the warning.
+    static constexpr int kBadEnum = -2;
+    static int filter_enum(const char* key, int value, const nlohmann::json* raw, std::string& shown) {
+        shown = std::to_string(value);
+        if (!raw) return value;
+        const auto it = raw->find(key);
+        if (it == raw->end()) return -1;
+        shown = cut(it->dump(), 40);
+        if (!(it->is_number_integer() || it->is_number_unsigned()) || !as_written(raw, key, value) || value < 0)
+            return kBadEnum;
+        return value;
+    }
+
+    Filter mag_filter(std::size_t si, int value, const nlohmann::json* raw) {
+        std::string shown;
+        const int v = filter_enum("magFilter", value, raw, shown);
+        if (v == TINYGLTF_TEXTURE_FILTER_NEAREST) return Filter::Nearest;
+        if (v == -1 || v == TINYGLTF_TEXTURE_FILTER_LINEAR) return Filter::Linear;
+        warn_once("sampler " + std::to_string(si) + ": magFilter " + shown +
+                  " is not NEAREST (9728) or LINEAR (9729), LINEAR used");
+        return Filter::Linear;
+    }
+
+    MinFilter min_filter(std::size_t si, int value, const nlohmann::json* raw) {
+        std::string shown;
+        switch (filter_enum("minFilter", value, raw, shown)) {
+        case -1: return MinFilter::LinearMipmapLinear;
+        case TINYGLTF_TEXTURE_FILTER_NEAREST: return MinFilter::Nearest;
+        case TINYGLTF_TEXTURE_FILTER_LINEAR: return MinFilter::Linear;
+        case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST: return MinFilter::NearestMipmapNearest;
+        case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST: return MinFilter::LinearMipmapNearest;
+        case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR: return MinFilter::NearestMipmapLinear;
+        case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR: return MinFilter::LinearMipmapLinear;
+        default: break;
+        }
+        warn_once("sampler " + std::to_string(si) + ": minFilter " + shown +
+                  " is not a glTF minification filter (9728, 9729, 9984 to 9987), LINEAR_MIPMAP_LINEAR used");
+        return MinFilter::LinearMipmapLinear;
+    }
+
     Material convert_material(const tinygltf::Material& g, std::size_t index) {
         Material m;
         m.name = g.name.empty() ? "material" + std::to_string(index) : g.name;
-        const std::string what = "material '" + m.name + "'";
+        const std::string what = "material '" + cut(m.name) + "'";
         const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
 
         m.base_color_factor = glm::vec4(1.0f);
@@ -564,19 +906,24 @@ private:
         };
         m.metallic_factor = unit(pbr.metallicFactor, 1.0f);
         m.roughness_factor = unit(pbr.roughnessFactor, 1.0f);
+        const char* const kPbr = "pbrMetallicRoughness";
         m.base_color = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                               pbr.baseColorTexture.extensions, what + " baseColorTexture");
+                               pbr.baseColorTexture.extensions, what + " baseColorTexture", index, kPbr,
+                               "baseColorTexture");
         m.metallic_roughness =
             texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-                    pbr.metallicRoughnessTexture.extensions, what + " metallicRoughnessTexture");
+                    pbr.metallicRoughnessTexture.extensions, what + " metallicRoughnessTexture", index, kPbr,
+                    "metallicRoughnessTexture");
         m.normal = texture(g.normalTexture.index, g.normalTexture.texCoord,
-                           g.normalTexture.extensions, what + " normalTexture");
+                           g.normalTexture.extensions, what + " normalTexture", index, nullptr, "normalTexture");
         m.normal_scale = std::isfinite(g.normalTexture.scale) ? float(g.normalTexture.scale) : 1.0f;
         m.occlusion = texture(g.occlusionTexture.index, g.occlusionTexture.texCoord,
-                              g.occlusionTexture.extensions, what + " occlusionTexture");
+                              g.occlusionTexture.extensions, what + " occlusionTexture", index, nullptr,
+                              "occlusionTexture");
         m.occlusion_strength = unit(g.occlusionTexture.strength, 1.0f);
         m.emissive = texture(g.emissiveTexture.index, g.emissiveTexture.texCoord,
-                             g.emissiveTexture.extensions, what + " emissiveTexture");
+                             g.emissiveTexture.extensions, what + " emissiveTexture", index, nullptr,
+                             "emissiveTexture");
         m.emissive_factor = glm::vec3(0.0f);
         if (g.emissiveFactor.size() == 3 && finite_values(g.emissiveFactor))
             m.emissive_factor = glm::vec3(g.emissiveFactor[0], g.emissiveFactor[1], g.emissiveFactor[2]);
@@ -587,7 +934,7 @@ private:
         } else if (g.alphaMode == "BLEND") {
             m.alpha_mode = AlphaMode::Blend;
         } else if (g.alphaMode != "OPAQUE") {
-            warn(what + ": unknown alphaMode '" + g.alphaMode + "', drawn opaque");
+            warn(what + ": unknown alphaMode '" + cut(g.alphaMode) + "', drawn opaque");
         }
         m.alpha_cutoff = std::isfinite(g.alphaCutoff) ? float(g.alphaCutoff) : 0.5f;
         m.double_sided = g.doubleSided;
@@ -603,11 +950,159 @@ private:
                     const double ior = value.Get("ior").GetNumberAsDouble();
                     if (std::isfinite(ior) && ior >= 1.0) m.ior = float(ior);
                 }
-            } else {
-                warn(what + ": extension " + name + " ignored");
+            } else if (name != "KHR_materials_pbrSpecularGlossiness") {
+                warn(what + ": extension " + cut(name) + " ignored");
             }
         }
+        const auto sg = g.extensions.find("KHR_materials_pbrSpecularGlossiness");
+        if (sg != g.extensions.end()) specular_glossiness(sg->second, m, what);
         return m;
+    }
+
+    // ---- KHR_materials_pbrSpecularGlossiness, converted to metal-rough
+
+    // A number array member of the extension: `fallback` when absent, warned
+    // and `fallback` when not `n` finite numbers in [0, 1].
+    std::vector<double> unit_numbers(const tinygltf::Value& v, const char* key, std::size_t n,
+                                     std::vector<double> fallback, const std::string& what) {
+        const tinygltf::Value& x = v.Get(key);
+        if (x.Type() == tinygltf::NULL_TYPE) return fallback;
+        std::vector<double> out;
+        if (x.IsNumber() && n == 1) out.push_back(x.GetNumberAsDouble());
+        if (x.IsArray() && x.ArrayLen() == n)
+            for (std::size_t i = 0; i < n; ++i)
+                if (x.Get(int(i)).IsNumber()) out.push_back(x.Get(int(i)).GetNumberAsDouble());
+        if (out.size() != n || !finite_values(out)) {
+            warn(what + ": bad " + key + ", default used");
+            return fallback;
+        }
+        for (double& d : out) d = std::clamp(d, 0.0, 1.0);
+        return out;
+    }
+
+    // A textureInfo member of the extension, as texture() reads the core ones.
+    TextureRef extension_texture(const tinygltf::Value& v, const char* key, const std::string& what) {
+        const tinygltf::Value& t = v.Get(key);
+        if (t.Type() == tinygltf::NULL_TYPE) return {};
+        if (!t.IsObject() || !t.Get("index").IsNumber()) {
+            warn(what + " " + key + ": not a textureInfo, ignored");
+            return {};
+        }
+        const tinygltf::Value& tc = t.Get("texCoord");
+        const int texcoord = tc.IsNumber() ? tc.GetNumberAsInt() : 0;
+        return texture(t.Get("index").GetNumberAsInt(), texcoord, {}, what + " " + key, 0, "", "");
+    }
+
+    // The material from the specular-glossiness parameters (see
+    // specular_glossiness_to_metal_rough for the formulas). Textures are
+    // converted texel by texel into two new images (base colour and
+    // metallic-roughness) unless the diffuse texture can serve as the base
+    // colour texture unchanged.
+    void specular_glossiness(const tinygltf::Value& v, Material& m, const std::string& what_material) {
+        const std::string what = what_material + " KHR_materials_pbrSpecularGlossiness";
+        if (!v.IsObject()) {
+            warn(what + ": not an object, ignored");
+            return;
+        }
+        const std::vector<double> d = unit_numbers(v, "diffuseFactor", 4, {1, 1, 1, 1}, what);
+        const std::vector<double> sp = unit_numbers(v, "specularFactor", 3, {1, 1, 1}, what);
+        const double gloss = unit_numbers(v, "glossinessFactor", 1, {1}, what)[0];
+        const glm::dvec4 diffuse(d[0], d[1], d[2], d[3]);
+        const glm::dvec3 specular(sp[0], sp[1], sp[2]);
+        const TextureRef diffuse_tex = extension_texture(v, "diffuseTexture", what);
+        const TextureRef sg_tex = extension_texture(v, "specularGlossinessTexture", what);
+
+        const MetalRough f = specular_glossiness_to_metal_rough(glm::dvec3(diffuse), specular, gloss, true);
+        m.base_color_factor = glm::vec4(glm::vec3(f.base), float(diffuse.a));
+        m.metallic_factor = float(f.metallic);
+        m.roughness_factor = float(f.roughness);
+        m.ior = float(f.ior);
+        m.metallic_roughness = {};
+        m.base_color = {};
+        if (!diffuse_tex.valid() && !sg_tex.valid()) return;
+        // A dielectric whose diffuse colour is the base colour: the diffuse
+        // texture is the base colour texture, scaled by the factor above.
+        const bool plain = !sg_tex.valid() && f.metallic == 0.0 && glm::dvec3(diffuse) != glm::dvec3(0.0);
+        if (plain) {
+            m.base_color = diffuse_tex;  // base = c_diff = diffuse (1 - max(specular)), times the texture
+            return;
+        }
+        bake_specular_glossiness(diffuse, specular, gloss, diffuse_tex, sg_tex, m, what);
+    }
+
+    void bake_specular_glossiness(const glm::dvec4& diffuse, const glm::dvec3& specular, double gloss,
+                                  const TextureRef& diffuse_tex, const TextureRef& sg_tex, Material& m,
+                                  const std::string& what) {
+        Image dimg, simg;
+        try {
+            if (diffuse_tex.valid()) dimg = decode_image(scene_.images[std::size_t(diffuse_tex.image)], true);
+            if (sg_tex.valid()) simg = decode_image(scene_.images[std::size_t(sg_tex.image)], true);
+        } catch (const LoadError& e) {
+            warn(what + ": textures not converted (" + e.what() + "), factors used");
+            return;
+        }
+        const Image& grid = dimg.texel_count() >= simg.texel_count() ? dimg : simg;
+        if (grid.empty() || std::int64_t(grid.texel_count()) > kMaxBakeTexels) {
+            warn(what + ": textures larger than " + std::to_string(kMaxBakeTexels) +
+                 " texels are not converted, factors used");
+            return;
+        }
+        if (diffuse_tex.valid() && sg_tex.valid() && diffuse_tex.texcoord != sg_tex.texcoord)
+            warn_once(what + ": diffuse and specular-glossiness textures on different UV sets are combined "
+                             "texel by texel (approximate)");
+        // The other image at the grid texel's centre, nearest texel.
+        const auto at = [&](const Image& img, int x, int y, const glm::vec4& none) {
+            if (img.empty()) return none;
+            const int ix = std::min(img.width - 1, int((x + 0.5) * img.width / grid.width));
+            const int iy = std::min(img.height - 1, int((y + 0.5) * img.height / grid.height));
+            return img.at(ix, iy);
+        };
+        const int w = grid.width, h = grid.height;
+        // Factor times texel: diffuse RGBA, and specular RGB with glossiness.
+        const auto dif = [&](int x, int y) { return diffuse * glm::dvec4(at(dimg, x, y, glm::vec4(1.0f))); };
+        const auto sgl = [&](int x, int y) {
+            return glm::dvec4(specular, gloss) * glm::dvec4(at(simg, x, y, glm::vec4(1.0f)));
+        };
+        const glm::dvec3 first_specular(sgl(0, 0));
+        bool one_specular = true;
+        for (int y = 0; y < h && one_specular; ++y)
+            for (int x = 0; x < w && one_specular; ++x) one_specular = glm::dvec3(sgl(x, y)) == first_specular;
+        // One specular colour over the whole texture: the exact per-material
+        // conversion holds texel by texel (its ior is per material).
+        const bool grey = one_specular && first_specular.r == first_specular.g && first_specular.g == first_specular.b;
+        auto base = std::make_shared<Image>(), mr = std::make_shared<Image>();
+        for (Image* img : {base.get(), mr.get()}) {
+            img->width = w;
+            img->height = h;
+            img->rgba.assign(grid.texel_count() * 4, 0.0f);
+        }
+        double ior = 1.5;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const glm::dvec4 d = dif(x, y), sg = sgl(x, y);
+                const MetalRough t = specular_glossiness_to_metal_rough(glm::dvec3(d), glm::dvec3(sg), sg.a, grey);
+                if (grey && t.ior != 1.5) ior = t.ior;
+                base->set(x, y, glm::vec4(glm::vec3(t.base), float(d.a)));
+                mr->set(x, y, glm::vec4(1.0f, float(t.roughness), float(t.metallic), 1.0f));
+            }
+        const TextureRef& first = diffuse_tex.valid() ? diffuse_tex : sg_tex;
+        const TextureRef& second = sg_tex.valid() ? sg_tex : diffuse_tex;
+        m.base_color = first;
+        m.base_color.image = add_decoded(std::move(base), first.image, "base colour");
+        m.metallic_roughness = second;
+        m.metallic_roughness.image = add_decoded(std::move(mr), second.image, "metallic-roughness");
+        m.base_color_factor = glm::vec4(1.0f);
+        m.metallic_factor = 1.0f;
+        m.roughness_factor = 1.0f;
+        m.ior = float(ior);
+    }
+
+    int add_decoded(std::shared_ptr<Image> img, int from, const char* what) {
+        ImageSource src;
+        src.name = scene_.images[std::size_t(from)].name + " (" + what + " from specular-glossiness)";
+        src.decoded = std::move(img);
+        scene_.images.push_back(std::move(src));
+        return int(scene_.images.size()) - 1;
     }
 
     // ---- Nodes
@@ -717,7 +1212,6 @@ private:
                          " out of range (" + std::to_string(model_.meshes.size()) + " meshes)");
                 add_mesh(node, std::size_t(node.mesh), world);
             }
-            if (node.skin >= 0) warn_once("skinning ignored (meshes drawn in bind pose)");
             add_light(node, i, world);
             for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
                 stack.push_back({*c, world});
@@ -731,9 +1225,8 @@ private:
         for (std::size_t p = 0; p < gmesh.primitives.size(); ++p) {
             const tinygltf::Primitive& prim = gmesh.primitives[p];
             const std::string what = "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p);
-            if (prim.mode != -1 && prim.mode != TINYGLTF_MODE_TRIANGLES) {
-                warn(what + ": mode " + std::to_string(prim.mode) +
-                     " is not supported (triangles only), skipped");
+            if (prim.mode < -1 || prim.mode > TINYGLTF_MODE_TRIANGLE_FAN) {
+                warn(what + ": mode " + std::to_string(prim.mode) + " is not a glTF primitive mode, skipped");
                 continue;
             }
             Mesh mesh;
@@ -745,6 +1238,8 @@ private:
             } else {
                 mesh.material = prim.material; // -1: finish_scene's default material
             }
+            mesh.source_node = int(&node - model_.nodes.data());  // for posing (scene/gltf_graph.h)
+            mesh.source_primitive = int(p);
             scene_.meshes.push_back(std::move(mesh));
         }
     }
@@ -764,21 +1259,29 @@ private:
         }
         for (const auto& [name, index] : prim.attributes) {
             (void)index;
-            if (name.rfind("COLOR_", 0) == 0) warn_once("vertex colours (COLOR_n) ignored");
-            if (name.rfind("JOINTS_", 0) == 0) warn_once("skinning ignored (meshes drawn in bind pose)");
+            if (name.rfind("COLOR_", 0) == 0 && name != "COLOR_0") warn_once("vertex colour sets other than COLOR_0 ignored");
         }
-        if (!prim.targets.empty()) warn_once("morph targets ignored");
+        const int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+        const bool triangles = mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+                               mode == TINYGLTF_MODE_TRIANGLE_FAN;
 
         // Read
         const std::vector<float> pos = read_accessor<float>(position, TINYGLTF_TYPE_VEC3, what + " POSITION");
         const std::size_t n = pos.size() / 3;
         if (n == 0) return false;
-        std::vector<float> nrm, uv, tan;
+        std::vector<float> nrm, uv, uv1, tan;
         const int normal = attribute("NORMAL"), texcoord = attribute("TEXCOORD_0"),
-                  tangent = attribute("TANGENT");
+                  texcoord1 = attribute("TEXCOORD_1"), tangent = attribute("TANGENT");
         if (normal >= 0) nrm = read_accessor<float>(normal, TINYGLTF_TYPE_VEC3, what + " NORMAL");
         if (texcoord >= 0) uv = read_accessor<float>(texcoord, TINYGLTF_TYPE_VEC2, what + " TEXCOORD_0");
+        // TEXCOORD_1 only for a material that samples it: other files read what they always did.
+        if (texcoord1 >= 0 && reads_uv1(prim.material))
+            uv1 = read_accessor<float>(texcoord1, TINYGLTF_TYPE_VEC2, what + " TEXCOORD_1");
+        else if (reads_uv1(prim.material))
+            warn(what + ": its material reads TEXCOORD_1, which it lacks (sampled at 0, 0)");
         if (tangent >= 0) tan = read_accessor<float>(tangent, TINYGLTF_TYPE_VEC4, what + " TANGENT");
+        int color_components = 0;
+        std::vector<float> rgba = read_colors(attribute("COLOR_0"), what, color_components);
         auto same_count = [&](std::vector<float>& v, std::size_t ncomp, const char* name) {
             if (!v.empty() && v.size() != n * ncomp) {
                 warn(what + ": " + name + " count differs from POSITION, ignored");
@@ -787,7 +1290,9 @@ private:
         };
         same_count(nrm, 3, "NORMAL");
         same_count(uv, 2, "TEXCOORD_0");
+        same_count(uv1, 2, "TEXCOORD_1");
         same_count(tan, 4, "TANGENT");
+        same_count(rgba, std::size_t(color_components), "COLOR_0");
 
         std::vector<std::uint32_t> indices;
         if (prim.indices >= 0) {
@@ -808,11 +1313,7 @@ private:
             indices.resize(n);
             for (std::size_t i = 0; i < n; ++i) indices[i] = std::uint32_t(i);
         }
-        if (indices.size() % 3 != 0) {
-            warn(what + ": index count " + std::to_string(indices.size()) + " not a multiple of 3, truncated");
-            indices.resize(indices.size() / 3 * 3);
-        }
-        if (indices.empty()) return false;
+        if (!assemble(mode, what, indices)) return false;
 
         // Transform to world space. A mirroring transform (negative determinant)
         // turns the winding and the tangent handedness around.
@@ -827,11 +1328,23 @@ private:
             for (std::size_t i = 0; i < n; ++i)
                 mesh.normals[i] = glm::vec3(glm::normalize(normal_matrix * glm::dvec3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2])));
         }
+        // glTF's UV convention is the project's (v = 0 is the top row): kept as they are.
         if (!uv.empty()) {
             mesh.uvs.resize(n);
             for (std::size_t i = 0; i < n; ++i) mesh.uvs[i] = glm::vec2(uv[2 * i], uv[2 * i + 1]);
         }
-        if (!tan.empty() && !uv.empty()) {
+        if (!uv1.empty()) {
+            mesh.uvs1.resize(n);
+            for (std::size_t i = 0; i < n; ++i) mesh.uvs1[i] = glm::vec2(uv1[2 * i], uv1[2 * i + 1]);
+        }
+        if (!rgba.empty()) {
+            // glTF 2.0, "Meshes": an RGB colour's alpha is 1.
+            const std::size_t c = std::size_t(color_components);
+            mesh.colors.resize(n);
+            for (std::size_t i = 0; i < n; ++i)
+                mesh.colors[i] = glm::vec4(rgba[c * i], rgba[c * i + 1], rgba[c * i + 2], c == 4 ? rgba[c * i + 3] : 1.0f);
+        }
+        if (!tan.empty() && (!uv.empty() || !uv1.empty())) {
             mesh.tangents.resize(n);
             for (std::size_t i = 0; i < n; ++i) {
                 const glm::dvec3 t = glm::normalize(linear * glm::dvec3(tan[4 * i], tan[4 * i + 1], tan[4 * i + 2]));
@@ -839,10 +1352,112 @@ private:
                 mesh.tangents[i] = glm::vec4(glm::vec3(t), mirrored ? -w : w);
             }
         }
-        if (mirrored)
-            for (std::size_t t = 0; t < indices.size(); t += 3) std::swap(indices[t + 1], indices[t + 2]);
+        if (triangles) {
+            if (mirrored)
+                for (std::size_t t = 0; t < indices.size(); t += 3) std::swap(indices[t + 1], indices[t + 2]);
+        } else {
+            mesh.topology = mode == TINYGLTF_MODE_POINTS ? Mesh::Topology::Points : Mesh::Topology::Lines;
+        }
         mesh.indices = std::move(indices);
         return true;
+    }
+
+    // True when material `index` (a glTF index, converted already) has a texture on TEXCOORD_1.
+    bool reads_uv1(int index) const {
+        if (index < 0 || std::size_t(index) >= scene_.materials.size()) return false;
+        const Material& m = scene_.materials[std::size_t(index)];
+        for (const TextureRef* t : {&m.base_color, &m.metallic_roughness, &m.roughness, &m.metallic, &m.normal,
+                                    &m.occlusion, &m.emissive})
+            if (t->valid() && t->texcoord == 1) return true;
+        return false;
+    }
+
+    // COLOR_0 (glTF 2.0, "Meshes": VEC3 or VEC4 of float, or of normalized
+    // unsigned bytes or shorts, mapped to [0, 1] as c / 255 and c / 65535):
+    // `components` values per vertex; none (warned) when the accessor has
+    // another form.
+    std::vector<float> read_colors(int index, const std::string& what, int& components) {
+        components = 0;
+        if (index < 0) return {};
+        if (std::size_t(index) >= model_.accessors.size())
+            fail(what + " COLOR_0: accessor " + std::to_string(index) + " out of range (" +
+                 std::to_string(model_.accessors.size()) + " accessors)");
+        const tinygltf::Accessor& a = model_.accessors[std::size_t(index)];
+        const bool unorm = a.normalized && (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                            a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+        if ((a.type != TINYGLTF_TYPE_VEC3 && a.type != TINYGLTF_TYPE_VEC4) ||
+            (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && !unorm)) {
+            warn(what + " COLOR_0: accessor " + std::to_string(index) +
+                 " is not a VEC3/VEC4 of float or normalized unsigned byte/short, ignored");
+            return {};
+        }
+        components = a.type == TINYGLTF_TYPE_VEC3 ? 3 : 4;
+        return read_accessor<float>(index, a.type, what + " COLOR_0");
+    }
+
+    // Turns the index list of a glTF topology into the Mesh's list: triangle
+    // triples, line pairs or points (glTF 2.0, "Meshes", the topology
+    // equations). Strip triangle i is (i, i+1, i+2) for even i and
+    // (i, i+2, i+1) for odd i, keeping every triangle's winding; fan
+    // triangle i is (i+1, i+2, 0); a line strip's segment i is (i, i+1) and a
+    // loop adds (last, 0). A count the topology cannot use is warned about:
+    // a partial last primitive is dropped, too few indices skip the
+    // primitive (false). The expanded list is charged to the element budget
+    // before it is allocated.
+    bool assemble(int mode, const std::string& what, std::vector<std::uint32_t>& indices) {
+        const std::size_t c = indices.size();
+        const auto too_few = [&](const char* topology, std::size_t least) {
+            if (c >= least) return false;
+            warn(what + ": " + std::to_string(c) + " indices, too few for " + topology + " (at least " +
+                 std::to_string(least) + "), skipped");
+            return true;
+        };
+        const auto expand = [&](std::size_t size) {
+            charge(size, what + " " + std::to_string(c) + " indices expanded to " + std::to_string(size));
+            std::vector<std::uint32_t> out;
+            out.reserve(size);
+            return out;
+        };
+        switch (mode) {
+        case TINYGLTF_MODE_POINTS: return c > 0;
+        case TINYGLTF_MODE_LINE: {
+            if (c % 2 != 0) {
+                warn(what + ": index count " + std::to_string(c) + " not a multiple of 2, truncated");
+                indices.resize(c / 2 * 2);
+            }
+            return !indices.empty();
+        }
+        case TINYGLTF_MODE_LINE_STRIP:
+        case TINYGLTF_MODE_LINE_LOOP: {
+            const bool loop = mode == TINYGLTF_MODE_LINE_LOOP;
+            if (too_few(loop ? "a line loop" : "a line strip", 2)) return false;
+            std::vector<std::uint32_t> out = expand(2 * (c - 1) + (loop ? 2 : 0));
+            for (std::size_t i = 0; i + 1 < c; ++i) out.insert(out.end(), {indices[i], indices[i + 1]});
+            if (loop) out.insert(out.end(), {indices[c - 1], indices[0]});
+            indices = std::move(out);
+            return true;
+        }
+        case TINYGLTF_MODE_TRIANGLE_STRIP:
+        case TINYGLTF_MODE_TRIANGLE_FAN: {
+            const bool strip = mode == TINYGLTF_MODE_TRIANGLE_STRIP;
+            if (too_few(strip ? "a triangle strip" : "a triangle fan", 3)) return false;
+            std::vector<std::uint32_t> out = expand(3 * (c - 2));
+            for (std::size_t i = 0; i + 2 < c; ++i) {
+                if (!strip) out.insert(out.end(), {indices[i + 1], indices[i + 2], indices[0]});
+                else if (i % 2 == 0) out.insert(out.end(), {indices[i], indices[i + 1], indices[i + 2]});
+                else out.insert(out.end(), {indices[i], indices[i + 2], indices[i + 1]});
+            }
+            indices = std::move(out);
+            return true;
+        }
+        default: {
+            if (c % 3 != 0) {
+                warn(what + ": index count " + std::to_string(c) + " not a multiple of 3, truncated");
+                indices.resize(c / 3 * 3);
+            }
+            return !indices.empty();
+        }
+        }
     }
 
     // Keeps what the flattened scene reads (meshes instanced by many nodes
@@ -897,7 +1512,7 @@ private:
                 return;
             }
         } else {
-            warn(what + ": light type '" + gl.type + "' unknown, ignored");
+            warn(what + ": light type '" + cut(gl.type) + "' unknown, ignored");
             return;
         }
         scene_.lights.push_back(light);

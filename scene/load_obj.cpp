@@ -99,7 +99,7 @@ public:
         const FileScope::Resolved where = scope_.resolve(scope_.root(), mat_id);
         if (!where.ok()) {
             if (where.missing)
-                warnings_.add(shown + ": material library '" + printable(mat_id) +
+                warnings_.add(shown + ": material library '" + printable(cut(mat_id)) +
                               "' not found; default material used");
             else warnings_.add(scope_.refusal("material library", mat_id, where) + "; default material used");
             return false;
@@ -110,7 +110,7 @@ public:
         try {
             bytes = read_regular_file(where.path, detail::kMaxFileBytes, mat_id);
             std::string why;
-            if (!scope_.charge(bytes.size(), why)) throw LoadError(printable(mat_id) + ": " + why);
+            if (!scope_.charge(bytes.size(), why)) throw LoadError(printable(cut(mat_id)) + ": " + why);
         } catch (const LoadError& e) {
             warnings_.add(shown + ": material library " + e.what() + "; default material used");
             return false;
@@ -225,7 +225,8 @@ public:
         std::istringstream in(text);
         const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &in, &reader,
                                          /*triangulate=*/true, /*default_vcols_fallback=*/false);
-        if (!ok) throw LoadError(shown_ + ": " + printable(first_line(err, "cannot parse OBJ")));
+        if (!ok)
+            throw LoadError(shown_ + ": " + printable(cut(first_line(err, "cannot parse OBJ"), 2 * kMaxShownChars)));
         if (keys_.size() != materials.size()) // cannot happen: only MtlReader adds materials
             throw LoadError(shown_ + ": internal error reading materials");
 
@@ -260,7 +261,7 @@ private:
             if (line.rfind("Material file [", 0) == 0 || line.rfind("Failed to load material", 0) == 0)
                 continue; // MtlReader reported it
             if (seen.size() > 8) { ++extra; continue; }
-            log_.add(shown_ + ": " + printable(line));
+            log_.add(shown_ + ": " + printable(cut(line, 2 * kMaxShownChars)));
         }
         if (extra > 0) log_.add(shown_ + ": " + std::to_string(extra) + " more parser warnings");
     }
@@ -272,9 +273,9 @@ private:
         if (texname.empty()) return -1;
         const FileScope::Resolved where = scope_.resolve(keys.dir, texname);
         if (!where.ok()) {
-            const std::string what = "material '" + material + "': " + key;
+            const std::string what = "material '" + cut(material) + "': " + key;
             if (where.missing)
-                log_.add(shown_ + ": " + printable(what) + " '" + printable(texname) + "' not found, ignored");
+                log_.add(shown_ + ": " + printable(what) + " '" + printable(cut(texname)) + "' not found, ignored");
             else log_.add(scope_.refusal(what, texname, where) + ", ignored");
             return -1;
         }
@@ -341,7 +342,7 @@ private:
             else if (c == "aluminium" || c == "aluminum") m.conductor = Conductor::Aluminium;
             else if (c == "silver") m.conductor = Conductor::Silver;
             else
-                log_.add(shown_ + ": material '" + printable(name) + "': unknown conductor 'Pc " + printable(c) +
+                log_.add(shown_ + ": material '" + printable(cut(name)) + "': unknown conductor 'Pc " + printable(cut(c)) +
                          "' ignored");
         }
         // Dissolve (`d`, or 1 - `Tr` as tinyobjloader reads it): glTF's BLEND
@@ -352,7 +353,7 @@ private:
             m.base_color_factor.a = float(std::max(0.0, dissolve));
         }
         if (!src.alpha_texname.empty())
-            log_.add(shown_ + ": material '" + printable(name) + "': map_d ignored (d / Tr are used)");
+            log_.add(shown_ + ": material '" + printable(cut(name)) + "': map_d ignored (d / Tr are used)");
         return m;
     }
 
@@ -445,6 +446,10 @@ private:
         Mesh& m = b.mesh;
         m.positions.push_back({attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
                                attrib.vertices[3 * v + 2]});
+        // Vertex colours (`v x y z r g b`): tinyobjloader keeps them only when
+        // every vertex has one; taken as linear, as Kd is.
+        if (attrib.colors.size() == attrib.vertices.size())
+            m.colors.push_back({attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2], 1.0f});
         if (c.normal_index >= 0) {
             const std::size_t n = std::size_t(c.normal_index);
             m.normals.push_back({attrib.normals[3 * n], attrib.normals[3 * n + 1],

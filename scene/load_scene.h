@@ -5,7 +5,7 @@
 //
 // Errors: a file that cannot be used throws LoadError with one line
 // "FILE: problem". A problem the loader can work around (a missing texture, an
-// unsupported extension or primitive mode, triangles with NaN corners) is one
+// optional extension it does not implement, triangles with NaN corners) is one
 // line "FILE: ..." in Scene::warnings, and the scene still loads; at most
 // kWarningsPerKind of a kind, then a count (scene/messages.h). No input may
 // crash or hang a loader: every index, offset and size in the file is checked,
@@ -57,10 +57,13 @@ std::vector<unsigned char> read_file(const std::string& path);
 // Lower-case extension with the dot ("" when none).
 std::string extension_lower(const std::string& path);
 
-// Shared last step of both loaders: per mesh, drops triangles with an index out
-// of range or a non-finite corner (one warning with the count), removes unused
-// vertices, repairs or computes normals and tangents, drops meshes without
-// triangles, makes sure materials is not empty and every mesh's material is
+// Shared last step of both loaders: per mesh, drops primitives (triangles,
+// lines or points, by Mesh::topology) with an index out of range or a
+// non-finite corner (one warning with the count), removes unused vertices,
+// repairs or computes normals (lines and points without normals keep none)
+// and tangents (on the normal map's UV set), sets NaN/Inf UVs to 0 and
+// NaN/Inf vertex colours to white and clamps colours to [0, 1], drops empty
+// meshes, makes sure materials is not empty and every mesh's material is
 // valid. Throws LoadError "PATH: no triangles" when nothing is left.
 void finish_scene(Scene& scene, const std::string& path);
 

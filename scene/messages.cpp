@@ -42,7 +42,37 @@ bool is_control(std::uint32_t cp) {
     return (cp >= 0x80 && cp <= 0x9F) || (cp >= 0x202A && cp <= 0x202E) || (cp >= 0x2066 && cp <= 0x2069);
 }
 
+// The bytes of the unit of `s` at i that printable() shows as one piece (an
+// ASCII character, a valid UTF-8 sequence, one invalid byte) and how many
+// characters it shows it as.
+std::size_t shown_unit(const std::string& s, std::size_t i, std::size_t& shown) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c >= 0x20 && c < 0x7F) return shown = 1, 1;
+    if (c < 0x80) {
+        shown = c == '\n' || c == '\r' || c == '\t' || c == 0x1B ? 2 : 4;
+        return 1;
+    }
+    std::uint32_t cp = 0;
+    const std::size_t n = utf8_sequence(s, i, cp);
+    if (n == 0) return shown = 4, 1;
+    shown = is_control(cp) ? 4 * n : 1;
+    return n;
+}
+
 } // namespace
+
+std::string cut(const std::string& s, std::size_t max_chars) {
+    std::size_t i = 0, chars = 0;
+    while (i < s.size()) {
+        std::size_t shown = 0;
+        const std::size_t n = shown_unit(s, i, shown);
+        if (chars + shown > max_chars) break;
+        chars += shown;
+        i += n;
+    }
+    if (i == s.size()) return s;
+    return s.substr(0, i) + "...";
+}
 
 std::string printable(const std::string& s) {
     std::string out;

@@ -18,6 +18,17 @@ namespace prast {
 // message holding one is printed.
 std::string printable(const std::string& s);
 
+// The most characters a name from a file (an extension, a material, a uri)
+// takes in a message: a 10,000-character name would make a 10,000-character
+// line that says no more than its first words.
+constexpr std::size_t kMaxShownChars = 200;
+
+// `s` cut to at most `max_chars` characters as printable() shows them, with
+// "..." appended when anything was cut; never inside a UTF-8 sequence or an
+// escape, so printable(cut(s)) is at most max_chars + 3 characters. Unchanged
+// when it fits. Cut the raw name, then make the message printable.
+std::string cut(const std::string& s, std::size_t max_chars = kMaxShownChars);
+
 // How many warnings of one kind are kept before the rest are only counted.
 constexpr std::size_t kWarningsPerKind = 5;
 

@@ -99,6 +99,12 @@ struct Mesh {
     // Strips, fans and loops are turned into these lists by the loaders.
     enum class Topology { Triangles, Lines, Points };
     Topology topology = Topology::Triangles;
+    // Where a glTF mesh came from, for posing (scene/animation.h): the node
+    // that instances it and the primitive's index in its mesh; -1 elsewhere.
+    int source_node = -1, source_primitive = -1;
+    // The primitive's vertex of each vertex here, once the loader has dropped
+    // unused ones; filled only when the scene has a SceneSource.
+    std::vector<std::uint32_t> source_vertex;
 };
 
 struct Light {
@@ -118,6 +124,20 @@ struct Bounds {
     float radius() const { return empty() ? 0.0f : glm::length(hi - lo) * 0.5f; }
 };
 
+struct SceneSource;  // scene/animation.h: nodes, skins, morph targets, animations
+
+// A camera of the file (glTF "cameras"), placed by the node `node`.
+struct SceneCamera {
+    std::string name;
+    int node = -1;
+    bool orthographic = false;
+    double yfov = 0.8;          // perspective: vertical field of view, radians
+    double aspect_ratio = 0.0;  // perspective: 0 when the file gives none
+    double xmag = 1.0, ymag = 1.0;  // orthographic: half width and height
+    double znear = 0.1;
+    double zfar = 0.0;          // 0: infinite (perspective without zfar)
+};
+
 struct Scene {
     std::vector<Mesh> meshes;
     std::vector<Material> materials;     // never empty after loading
@@ -127,6 +147,15 @@ struct Scene {
     // the built-in scene's sky; null = none. `render --env` overrides it.
     std::shared_ptr<const Image> environment;
     std::vector<std::string> warnings;   // one line each: "FILE: what was ignored/fallen back"
+    // What posing needs (skins, morph targets, animations; scene/animation.h);
+    // null for a static file, whose meshes never change.
+    std::shared_ptr<const SceneSource> source;
+    std::vector<SceneCamera> cameras;          // the file's, in node order
+    std::vector<std::string> animation_names;  // one per animation ("animation N" when unnamed)
+    std::vector<std::string> extensions_used, extensions_required;  // glTF's lists, for render --list
+    // Counts the poses applied, so that what is drawn from the meshes
+    // (shadow maps) is redrawn when they change.
+    std::uint64_t pose_serial = 0;
 
     Bounds bounds() const {
         Bounds b;

@@ -32,6 +32,11 @@ bool triangle(const Mesh& mesh, std::size_t t, std::uint32_t (&v)[3]) {
     return true;
 }
 
+// Lines and points carry no surface: no triangle contributes to their frames.
+std::size_t triangle_count(const Mesh& mesh) {
+    return mesh.topology == Mesh::Topology::Triangles ? mesh.indices.size() / 3 : 0;
+}
+
 } // namespace
 
 glm::vec3 any_perpendicular(const glm::vec3& n) {
@@ -43,7 +48,7 @@ glm::vec3 any_perpendicular(const glm::vec3& n) {
 
 void compute_normals(Mesh& mesh) {
     std::vector<glm::dvec3> sum(mesh.positions.size(), glm::dvec3(0.0));
-    const std::size_t triangles = mesh.indices.size() / 3;
+    const std::size_t triangles = triangle_count(mesh);
     for (std::size_t t = 0; t < triangles; ++t) {
         std::uint32_t v[3];
         if (!triangle(mesh, t, v)) continue;
@@ -62,9 +67,11 @@ void compute_normals(Mesh& mesh) {
     }
 }
 
-void compute_tangents(Mesh& mesh) {
+void compute_tangents(Mesh& mesh) { compute_tangents(mesh, mesh.uvs); }
+
+void compute_tangents(Mesh& mesh, const std::vector<glm::vec2>& uvs) {
     const std::size_t n = mesh.positions.size();
-    if (mesh.uvs.size() != n || n == 0) {
+    if (uvs.size() != n || n == 0) {
         mesh.tangents.clear();
         return;
     }
@@ -72,14 +79,13 @@ void compute_tangents(Mesh& mesh) {
 
     // Accumulate T = dP/du and B = -dP/dv per corner
     std::vector<glm::dvec3> sum_t(n, glm::dvec3(0.0)), sum_b(n, glm::dvec3(0.0));
-    const std::size_t triangles = mesh.indices.size() / 3;
+    const std::size_t triangles = triangle_count(mesh);
     for (std::size_t t = 0; t < triangles; ++t) {
         std::uint32_t v[3];
         if (!triangle(mesh, t, v)) continue;
         const glm::dvec3 p[3] = {glm::dvec3(mesh.positions[v[0]]), glm::dvec3(mesh.positions[v[1]]),
                                  glm::dvec3(mesh.positions[v[2]])};
-        const glm::dvec2 uv[3] = {glm::dvec2(mesh.uvs[v[0]]), glm::dvec2(mesh.uvs[v[1]]),
-                                  glm::dvec2(mesh.uvs[v[2]])};
+        const glm::dvec2 uv[3] = {glm::dvec2(uvs[v[0]]), glm::dvec2(uvs[v[1]]), glm::dvec2(uvs[v[2]])};
         const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
         const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
         const double r = d1.x * d2.y - d2.x * d1.y;

@@ -25,6 +25,9 @@ void compute_normals(Mesh& mesh);
 // w = sign(dot(cross(N, T), B)). Degenerate UVs: any unit vector perpendicular
 // to N, w = 1.
 void compute_tangents(Mesh& mesh);
+// The same from another UV set of the mesh (e.g. mesh.uvs1, when the normal
+// map reads TEXCOORD_1); `uvs` must outlive the call and not be mesh.tangents.
+void compute_tangents(Mesh& mesh, const std::vector<glm::vec2>& uvs);
 
 // Any unit vector perpendicular to the unit vector n.
 glm::vec3 any_perpendicular(const glm::vec3& n);

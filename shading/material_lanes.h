@@ -28,10 +28,21 @@ struct SurfaceLanes {
     const float *Px, *Py, *Pz;      // world position
     const float *Nx, *Ny, *Nz;      // interpolated vertex normal
     const float *Tx, *Ty, *Tz, *Tw; // tangent + handedness
-    const float *u, *v;
+    const float *u, *v;             // UV set 0
     const std::uint8_t* quad = nullptr;
     float dudx[kMaxQuadSlots], dvdx[kMaxQuadSlots], dudy[kMaxQuadSlots], dvdy[kMaxQuadSlots];  // per quad
     std::uint32_t back_facing = 0;  // lanes of back-facing triangles
+    // UV sets 1 .. kMaxUvSets - 1 and their per-quad derivatives, filled only
+    // when the material reads them (BoundMaterial::reads_extra_uv_sets).
+    const float* u_more[kMaxUvSets - 1] = {};
+    const float* v_more[kMaxUvSets - 1] = {};
+    float dudx_more[kMaxUvSets - 1][kMaxQuadSlots], dvdx_more[kMaxUvSets - 1][kMaxQuadSlots];
+    float dudy_more[kMaxUvSets - 1][kMaxQuadSlots], dvdy_more[kMaxUvSets - 1][kMaxQuadSlots];
+    // The vertex colour (linear RGBA); null when the mesh has none.
+    const float *Cr = nullptr, *Cg = nullptr, *Cb = nullptr, *Ca = nullptr;
+
+    const float* u_of(int set) const { return set == 0 ? u : u_more[set - 1]; }
+    const float* v_of(int set) const { return set == 0 ? v : v_more[set - 1]; }
 };
 
 namespace material_lanes_detail {
@@ -75,6 +86,17 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     const bool mask_mode = m.alpha_mode == AlphaMode::Mask;
     const bool alpha_read = mask_mode || m.alpha_mode == AlphaMode::Blend;
     const std::uint8_t used[kMaps] = {std::uint8_t(alpha_read ? 0xF : 0x7), 0x6, 0x1, 0x1, 0x7, 0x1, 0x7};
+    // UV sets: all 0 unless a map reads another (one test on the usual path).
+    std::uint64_t uv_word = 0;
+    static_assert(sizeof(bm.uv) <= sizeof(uv_word), "the UV sets fit one word");
+    std::memcpy(&uv_word, &bm.uv, sizeof(bm.uv));
+    const bool multi_uv = uv_word != 0;
+    std::uint8_t set[kMaps] = {};
+    if (multi_uv) {
+        set[kBase] = bm.uv.base_color; set[kMetalRough] = bm.uv.metallic_roughness; set[kRough] = bm.uv.roughness;
+        set[kMetal] = bm.uv.metallic; set[kNormal] = bm.uv.normal; set[kOcclusion] = bm.uv.occlusion;
+        set[kEmissive] = bm.uv.emissive;
+    }
     TexelLanes texel[kMaps];
     const TexelLanes* tl[kMaps];
     for (int i = 0; i < kMaps; ++i) tl[i] = &texel[i];
@@ -87,26 +109,32 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
             for (int l = 0; l < N; ++l)
                 if ((live >> l) & 1u) live_quads |= 1u << s.quad[l];
         }
-        // Group the maps by layout, in order of first appearance.
+        // Group the maps by layout and UV set, in order of first appearance.
         int groups = 0;
         const Texture* group_tex[kMaps][kMaps];
         TexelLanes* group_out[kMaps][kMaps];
         std::uint8_t group_used[kMaps][kMaps];
+        std::uint8_t group_set[kMaps];
         int group_size[kMaps];
         for (int i = 0; i < kMaps; ++i) {
             if (!maps[i]) continue;
             int j = 0;
-            while (j < i && maps[j] != maps[i]) ++j;
-            if (j < i) {  // the same texture again: share its lookup
+            while (j < i && (maps[j] != maps[i] || (multi_uv && set[j] != set[i]))) ++j;
+            if (j < i) {  // the same texture at the same uv again: share its lookup
                 tl[i] = tl[j];
                 for (int g = 0; g < groups; ++g)
                     for (int k = 0; k < group_size[g]; ++k)
-                        if (group_tex[g][k] == maps[i]) group_used[g][k] |= used[i];
+                        if (group_tex[g][k] == maps[i] && (!multi_uv || group_set[g] == set[i]))
+                            group_used[g][k] |= used[i];
                 continue;
             }
             int g = 0;
-            while (g < groups && !same_sampling_layout(*group_tex[g][0], *maps[i])) ++g;
-            if (g == groups) group_size[groups++] = 0;
+            while (g < groups && !((!multi_uv || group_set[g] == set[i]) && same_sampling_layout(*group_tex[g][0], *maps[i])))
+                ++g;
+            if (g == groups) {
+                group_set[groups] = set[i];
+                group_size[groups++] = 0;
+            }
             group_tex[g][group_size[g]] = maps[i];
             group_used[g][group_size[g]] = used[i];
             group_out[g][group_size[g]++] = &texel[i];
@@ -114,13 +142,18 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         for (int g = 0; g < groups; ++g) {
             // material_lods(): one lambda per quad with a live lane.
             const Texture& first = *group_tex[g][0];
+            const int uv_set = group_set[g];
+            const float* dudx = uv_set ? s.dudx_more[uv_set - 1] : s.dudx;
+            const float* dvdx = uv_set ? s.dvdx_more[uv_set - 1] : s.dvdx;
+            const float* dudy = uv_set ? s.dudy_more[uv_set - 1] : s.dudy;
+            const float* dvdy = uv_set ? s.dvdy_more[uv_set - 1] : s.dvdy;
             float lambda[kMaxQuadSlots];
             for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
                 const int q = __builtin_ctz(qs);
-                lambda[q] = first.lod(s.dudx[q], s.dvdx[q], s.dudy[q], s.dvdy[q]);
+                lambda[q] = first.lod(dudx[q], dvdx[q], dudy[q], dvdy[q]);
             }
             TrilinearLanes at;
-            prepare_trilinear_lanes<N>(first, s.u, s.v, lambda, s.quad, live, at);
+            prepare_trilinear_lanes<N>(first, s.u_of(uv_set), s.v_of(uv_set), lambda, s.quad, live, at);
             fetch_trilinear_lanes<N>(group_tex[g], group_size[g], at, group_out[g], group_used[g]);
         }
     }
@@ -142,6 +175,13 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
             mb.ar[l] = bf.r; mb.ag[l] = bf.g; mb.ab[l] = bf.b;
             alpha[l] = bf.a;
         }
+    }
+    if (s.Cr) {  // times the vertex colour
+        for (int l = 0; l < N; ++l) {
+            mb.ar[l] *= s.Cr[l]; mb.ag[l] *= s.Cg[l]; mb.ab[l] *= s.Cb[l];
+        }
+        if (alpha_read)
+            for (int l = 0; l < N; ++l) alpha[l] *= s.Ca[l];
     }
     mb.ior = m.ior;
 

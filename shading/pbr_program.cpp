@@ -49,12 +49,39 @@ BrdfTerms first_light_terms(const MaterialSample& ms, const SurfacePoint& sp, co
     return evaluate_brdf(bi, ctx.model);
 }
 
-// The varyings' arrays as the lit path's surface.
-void set_surface(SurfaceLanes& s, const float* const* var) {
+// The varyings' arrays as the lit path's surface (the wide layout's UV sets
+// and colour too: colour only when the mesh has one).
+template <int NV>
+void set_surface(SurfaceLanes& s, const float* const* var, bool has_color) {
     s.Px = var[kVarP]; s.Py = var[kVarP + 1]; s.Pz = var[kVarP + 2];
     s.Nx = var[kVarN]; s.Ny = var[kVarN + 1]; s.Nz = var[kVarN + 2];
     s.Tx = var[kVarT]; s.Ty = var[kVarT + 1]; s.Tz = var[kVarT + 2]; s.Tw = var[kVarT + 3];
     s.u = var[kVarUV]; s.v = var[kVarUV + 1];
+    if constexpr (NV == kPbrVaryingsExt) {
+        for (int set = 1; set < kMaxUvSets; ++set) {
+            s.u_more[set - 1] = var[var_uv(set)];
+            s.v_more[set - 1] = var[var_uv(set) + 1];
+        }
+        if (has_color) {
+            s.Cr = var[kVarColor]; s.Cg = var[kVarColor + 1]; s.Cb = var[kVarColor + 2]; s.Ca = var[kVarColor + 3];
+        }
+    } else {
+        (void)has_color;
+    }
+}
+
+// Quad q's derivatives of the UV sets past 0, from lane l of `in`, into slot.
+template <int NV>
+inline void set_more_derivatives(SurfaceLanes& s, const FragmentBlock<NV>& in, int l, int slot) {
+    if constexpr (NV == kPbrVaryingsExt) {
+        for (int set = 1; set < kMaxUvSets; ++set) {
+            const int k = var_uv(set);
+            s.dudx_more[set - 1][slot] = in.ddx(k, l); s.dvdx_more[set - 1][slot] = in.ddx(k + 1, l);
+            s.dudy_more[set - 1][slot] = in.ddy(k, l); s.dvdy_more[set - 1][slot] = in.ddy(k + 1, l);
+        }
+    } else {
+        (void)s; (void)in; (void)l; (void)slot;
+    }
 }
 
 // The lanes of mask m in order, as bytes, into out[0, 16) (zero past them).
@@ -102,8 +129,8 @@ inline __m256 take_packed(const float* src, __m256i pos) {
 // repeat the last live one. Rows hold N + 8 floats: with AVX2 each block's
 // lanes are stored eight at a time, spilling into the next block's (written
 // after) or the spare lanes (written last).
-template <int N>
-void pack_lanes(const FragmentBlock<kPbrVaryings>* const* in, int count, const std::uint8_t* first,
+template <int N, int NV>
+void pack_lanes(const FragmentBlock<NV>* const* in, int count, const std::uint8_t* first,
                 const std::uint8_t* lane, float (*packed)[N + 8]) {
     const int n = first[count];
 #if defined(__AVX2__)
@@ -114,7 +141,7 @@ void pack_lanes(const FragmentBlock<kPbrVaryings>* const* in, int count, const s
             // will do there.
             const __m256i idx = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(lane + j)));
             const __m256 from_high = _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7)));
-            for (int k = 0; k < kPbrVaryings; ++k) {
+            for (int k = 0; k < NV; ++k) {
                 const __m256 lo = _mm256_permutevar8x32_ps(_mm256_load_ps(in[b]->var[k]), idx);
                 const __m256 hi = _mm256_permutevar8x32_ps(_mm256_load_ps(in[b]->var[k] + 8), idx);
                 _mm256_storeu_ps(packed[k] + j, _mm256_blendv_ps(lo, hi, from_high));
@@ -124,7 +151,7 @@ void pack_lanes(const FragmentBlock<kPbrVaryings>* const* in, int count, const s
 #else
     for (int b = 0; b < count; ++b)
         for (int i = first[b]; i < first[b + 1]; ++i)
-            for (int k = 0; k < kPbrVaryings; ++k) packed[k][i] = in[b]->var[k][lane[i]];
+            for (int k = 0; k < NV; ++k) packed[k][i] = in[b]->var[k][lane[i]];
 #endif
     if (n == N) return;
 #if defined(__AVX2__)
@@ -133,13 +160,13 @@ void pack_lanes(const FragmentBlock<kPbrVaryings>* const* in, int count, const s
     for (int h = (n / 8) * 8; h < N; h += 8) {
         const __m256 spare = _mm256_castsi256_ps(
             _mm256_cmpgt_epi32(_mm256_add_epi32(_mm256_set1_epi32(h), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)), spare_from));
-        for (int k = 0; k < kPbrVaryings; ++k) {
+        for (int k = 0; k < NV; ++k) {
             const __m256 last = _mm256_broadcast_ss(&packed[k][n - 1]);
             _mm256_storeu_ps(packed[k] + h, _mm256_blendv_ps(_mm256_loadu_ps(packed[k] + h), last, spare));
         }
     }
 #else
-    for (int k = 0; k < kPbrVaryings; ++k)
+    for (int k = 0; k < NV; ++k)
         for (int i = n; i < N; ++i) packed[k][i] = packed[k][n - 1];
 #endif
 }
@@ -149,15 +176,17 @@ void pack_lanes(const FragmentBlock<kPbrVaryings>* const* in, int count, const s
 // The lit path (material_lanes.h, then light_block.h) for all 16 lanes of a
 // block in place. Each lane does the float operations of sample_material()
 // and shade_surface().
-void PbrProgram::shade_block(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
+template <int NV>
+void PbrProgramT<NV>::shade_block(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
     SurfaceLanes s;
     const float* var[kVaryings];
     for (int k = 0; k < kVaryings; ++k) var[k] = in.var[k];
-    set_surface(s, var);
+    set_surface<NV>(s, var, has_color());
     for (int q = 0; q < 4; ++q) {
         const int l = 4 * q;  // the quad's derivatives, as surface_point() takes them
         s.dudx[q] = in.ddx(kVarUV, l); s.dvdx[q] = in.ddx(kVarUV + 1, l);
         s.dudy[q] = in.ddy(kVarUV, l); s.dvdy[q] = in.ddy(kVarUV + 1, l);
+        set_more_derivatives<NV>(s, in, l, q);
     }
     s.back_facing = in.front_facing ? 0u : 0xFFFFu;
 
@@ -177,8 +206,9 @@ void PbrProgram::shade_block(const FragmentBlock<kVaryings>& in, FragmentOut& ou
 // Each (block, quad) with a live lane gets a quad slot of its own, with its
 // derivatives; the spare packed lanes repeat the last live lane (valid
 // inputs, results dropped).
+template <int NV>
 template <int N>
-void PbrProgram::shade_packed(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out, int count) const {
+void PbrProgramT<NV>::shade_packed(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out, int count) const {
     static_assert(N == 4 || N == 8 || N == 16, "packed calls have 4, 8 or 16 lanes");
     SurfaceLanes s;
     // lane[i], quad[i]: packed lane i's block lane and quad slot; each block
@@ -193,6 +223,7 @@ void PbrProgram::shade_packed(const FragmentBlock<kVaryings>* const* in, Fragmen
             slot_of[q] = std::uint8_t(slots);
             s.dudx[slots] = B.ddx(kVarUV, 4 * q); s.dvdx[slots] = B.ddx(kVarUV + 1, 4 * q);
             s.dudy[slots] = B.ddy(kVarUV, 4 * q); s.dvdy[slots] = B.ddy(kVarUV + 1, 4 * q);
+            set_more_derivatives<NV>(s, B, 4 * q, slots);
             ++slots;
         }
         first[b] = std::uint8_t(n);
@@ -217,9 +248,9 @@ void PbrProgram::shade_packed(const FragmentBlock<kVaryings>* const* in, Fragmen
 
     alignas(64) float packed[kVaryings][N + 8];
     const float* var[kVaryings];
-    pack_lanes<N>(in, count, first, lane, packed);
+    pack_lanes<N, NV>(in, count, first, lane, packed);
     for (int k = 0; k < kVaryings; ++k) var[k] = packed[k];
-    set_surface(s, var);
+    set_surface<NV>(s, var, has_color());
     s.quad = quad;
 
     MaterialBlock mb;
@@ -263,13 +294,15 @@ void PbrProgram::shade_packed(const FragmentBlock<kVaryings>* const* in, Fragmen
     }
 }
 
-bool PbrProgram::lit_lanes() const {
+template <int NV>
+bool PbrProgramT<NV>::lit_lanes() const {
     const bool reference = ctx->env && ctx->ibl == IblMode::Reference;
     return (view == DebugView::None || view == DebugView::Tiles) && material->m->conductor == Conductor::None &&
            !reference;
 }
 
-void PbrProgram::fragment_batch(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out,
+template <int NV>
+void PbrProgramT<NV>::fragment_batch(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out,
                                 int count) const {
     if (!lit_lanes()) {
         for (int b = 0; b < count; ++b) fragment(*in[b], *out[b]);
@@ -279,7 +312,8 @@ void PbrProgram::fragment_batch(const FragmentBlock<kVaryings>* const* in, Fragm
 }
 
 // shade_packed() with the fewest lanes that hold the blocks' live ones.
-void PbrProgram::shade_packed_lanes(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out,
+template <int NV>
+void PbrProgramT<NV>::shade_packed_lanes(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out,
                                     int count) const {
     int live = 0;
     for (int b = 0; b < count; ++b) live += __builtin_popcount(in[b]->mask);
@@ -287,12 +321,13 @@ void PbrProgram::shade_packed_lanes(const FragmentBlock<kVaryings>* const* in, F
         for (int b = 0; b < count; ++b) fragment(*in[b], *out[b]);
         return;
     }
-    if (live > 8) shade_packed<16>(in, out, count);
-    else if (live > 4) shade_packed<8>(in, out, count);
-    else shade_packed<4>(in, out, count);
+    if (live > 8) this->template shade_packed<16>(in, out, count);
+    else if (live > 4) this->template shade_packed<8>(in, out, count);
+    else this->template shade_packed<4>(in, out, count);
 }
 
-void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
+template <int NV>
+void PbrProgramT<NV>::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
     const Material& m = *material->m;
     // The lit path samples the material and lights the lanes together, packed
     // when few are live; debug views, conductor materials and the reference
@@ -309,15 +344,16 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
     }
 
     const bool alpha_mask = m.alpha_mode == AlphaMode::Mask;
+    const bool colored = has_color();
     MaterialLods lods;
     for (int l = 0; l < kBlockLanes; ++l) {
         out.r[l] = 0.0f; out.g[l] = 0.0f; out.b[l] = 0.0f; out.a[l] = 1.0f;
         if (!(in.mask & (1u << l))) continue;
-        SurfacePoint sp = surface_point(in, l);
+        SurfacePoint sp = surface_point(in, l, colored);
         // The quad's lanes share derivatives, hence levels of detail: compute
         // them at the first live lane of each quad.
         if (!(in.mask & (0xFu << (l & ~3)) & ((1u << l) - 1)))
-            lods = material_lods(*material, sp.duv_dx, sp.duv_dy);
+            lods = material_lods(*material, sp);
         MaterialSample ms = sample_material(*material, sp, lods);
         if (alpha_mask && !(ms.alpha >= m.alpha_cutoff)) {
             out.kill |= 1u << l;
@@ -353,5 +389,8 @@ void PbrProgram::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) 
         if (m.alpha_mode == AlphaMode::Blend) out.a[l] = ms.alpha;
     }
 }
+
+template struct PbrProgramT<kPbrVaryings>;
+template struct PbrProgramT<kPbrVaryingsExt>;
 
 } // namespace prast

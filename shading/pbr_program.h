@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -16,11 +17,26 @@
 
 namespace prast {
 
-// Varying layout.
-enum : int { kVarP = 0, kVarN = 3, kVarUV = 6, kVarT = 8, kPbrVaryings = 12 };
+// Varying layout. A draw whose mesh has vertex colours, or whose material
+// reads a UV set past TEXCOORD_0, runs the wider layout (PbrProgramExt):
+// the first kPbrVaryings are the same, then UV sets 1 .. kMaxUvSets - 1 (two
+// floats each) and the RGBA colour. Every other draw keeps the narrow one and
+// pays for nothing more.
+enum : int {
+    kVarP = 0, kVarN = 3, kVarUV = 6, kVarT = 8, kPbrVaryings = 12,
+    kVarUVMore = kPbrVaryings,
+    kVarColor = kVarUVMore + 2 * (kMaxUvSets - 1),
+    kPbrVaryingsExt = kVarColor + 4
+};
 
-struct PbrProgram {
-    static constexpr int kVaryings = kPbrVaryings;
+// The first varying of UV set `set`.
+constexpr int var_uv(int set) { return set == 0 ? kVarUV : kVarUVMore + 2 * (set - 1); }
+
+template <int NV>
+struct PbrProgramT {
+    static constexpr int kVaryings = NV;
+    static constexpr bool kExtended = NV == kPbrVaryingsExt;
+    static_assert(NV == kPbrVaryings || NV == kPbrVaryingsExt, "the two layouts");
 
     const Mesh* mesh = nullptr;
     glm::mat4 view_proj{1.0f};
@@ -40,9 +56,26 @@ struct PbrProgram {
         var[kVarUV + 0] = uv.x; var[kVarUV + 1] = uv.y;
         glm::vec4 t = i < mesh->tangents.size() ? mesh->tangents[i] : glm::vec4(1.0f, 0.0f, 0.0f, 1.0f);
         var[kVarT + 0] = t.x; var[kVarT + 1] = t.y; var[kVarT + 2] = t.z; var[kVarT + 3] = t.w;
+        if constexpr (kExtended) {
+            for (int set = 1; set < kMaxUvSets; ++set) {
+                const std::vector<glm::vec2>& uvs = uv_set(*mesh, set);
+                const glm::vec2 st = i < uvs.size() ? uvs[i] : glm::vec2(0.0f);
+                var[var_uv(set)] = st.x; var[var_uv(set) + 1] = st.y;
+            }
+            const glm::vec4 c = i < mesh->colors.size() ? mesh->colors[i] : glm::vec4(1.0f);
+            var[kVarColor + 0] = c.r; var[kVarColor + 1] = c.g; var[kVarColor + 2] = c.b; var[kVarColor + 3] = c.a;
+        }
     }
 
-    static SurfacePoint surface_point(const FragmentBlock<kVaryings>& in, int l) {
+    // The mesh's UV set `set` (1 .. kMaxUvSets - 1).
+    static const std::vector<glm::vec2>& uv_set(const Mesh& m, int set) {
+        static_assert(kMaxUvSets == 2, "name the further UV sets of Mesh here");
+        (void)set;
+        return m.uvs1;
+    }
+
+    // has_color: the mesh has vertex colours (the wide layout only).
+    static SurfacePoint surface_point(const FragmentBlock<kVaryings>& in, int l, bool has_color = false) {
         SurfacePoint sp;
         sp.P = {in.var[kVarP][l], in.var[kVarP + 1][l], in.var[kVarP + 2][l]};
         sp.N = {in.var[kVarN][l], in.var[kVarN + 1][l], in.var[kVarN + 2][l]};
@@ -51,8 +84,24 @@ struct PbrProgram {
         sp.duv_dx = {in.ddx(kVarUV, l), in.ddx(kVarUV + 1, l)};
         sp.duv_dy = {in.ddy(kVarUV, l), in.ddy(kVarUV + 1, l)};
         sp.front_facing = in.front_facing;
+        if constexpr (kExtended) {
+            for (int set = 1; set < kMaxUvSets; ++set) {
+                const int k = var_uv(set);
+                sp.uv_more[set - 1] = {in.var[k][l], in.var[k + 1][l]};
+                sp.duv_more_dx[set - 1] = {in.ddx(k, l), in.ddx(k + 1, l)};
+                sp.duv_more_dy[set - 1] = {in.ddy(k, l), in.ddy(k + 1, l)};
+            }
+            if (has_color) {
+                sp.has_color = true;
+                sp.color = {in.var[kVarColor][l], in.var[kVarColor + 1][l], in.var[kVarColor + 2][l],
+                            in.var[kVarColor + 3][l]};
+            }
+        } else {
+            (void)has_color;
+        }
         return sp;
     }
+    bool has_color() const { return kExtended && !mesh->colors.empty(); }
 
     void fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const;
     // Several sparse blocks at once (raster/fragment.h): the same bytes as
@@ -66,5 +115,15 @@ private:
     template <int N>
     void shade_packed(const FragmentBlock<kVaryings>* const* in, FragmentOut* const* out, int count) const;
 };
+
+using PbrProgram = PbrProgramT<kPbrVaryings>;
+using PbrProgramExt = PbrProgramT<kPbrVaryingsExt>;
+extern template struct PbrProgramT<kPbrVaryings>;
+extern template struct PbrProgramT<kPbrVaryingsExt>;
+
+// Whether a draw of `mesh` with `bm` needs the wide layout.
+inline bool needs_extended_varyings(const Mesh& mesh, const BoundMaterial& bm) {
+    return !mesh.colors.empty() || bm.reads_extra_uv_sets();
+}
 
 } // namespace prast

@@ -7,11 +7,12 @@
 // into floats (a gather from the sRGB table, or a division by 255), then the
 // bilinear and trilinear blends across lanes. Float textures are read one live
 // lane at a time (one 4-channel vector per texel). Every lane performs exactly
-// the float operations of Texture::sample_trilinear() in the same order, so
+// the float operations of Texture::sample_lod() (the texture's filters;
+// sample_trilinear() for the default ones) in the same order, so
 // the two agree bit for bit (tests/test_sample_lanes.cpp); the stepper and the
 // debug views keep using the scalar sampler.
 //
-// The indices depend only on the level-0 size and the wrap modes, as does
+// The indices depend only on the level-0 size and the sampler, as does
 // lambda (Texture::lod), so textures with the same layout share one
 // preparation: a material whose maps have one size prepares once per block.
 // The loops run over the first N lanes (4, 8 or 16): the fragment program
@@ -52,14 +53,17 @@ struct TrilinearLanes {
     alignas(64) float txa[N], tya[N], txb[N], tyb[N], t[N];
     std::uint32_t live = 0;     // lanes to fetch
     std::uint32_t blend = 0;    // lanes that blend two levels
+    // Lanes whose quad reads the NEAREST texel (non-default filters): their
+    // four indices are that texel's and their weights 0, which blends 8-bit
+    // (finite) texels to exactly the texel; float texels are read as is.
+    std::uint32_t nearest = 0;
 };
 
 // True when a and b sample at the same texel indices with the same weights
 // for any uv and derivatives: same level-0 size (hence the same chain and the
-// same lambda) and the same wrap modes.
+// same lambda) and the same sampler (wrap modes and filters).
 inline bool same_sampling_layout(const Texture& a, const Texture& b) {
-    return a.width(0) == b.width(0) && a.height(0) == b.height(0) && a.wrap_s() == b.wrap_s() &&
-           a.wrap_t() == b.wrap_t();
+    return a.width(0) == b.width(0) && a.height(0) == b.height(0) && a.sampler_key() == b.sampler_key();
 }
 
 // Quads a packed call may draw its lanes from: a live lane each at most.
@@ -108,6 +112,22 @@ inline void bilinear_indices(const float* __restrict ur, const float* __restrict
     }
 }
 
+// Texture::nearest_reduced() up to the texel index, for the lanes in `lanes`
+// (the others keep their bilinear indices and weights).
+template <int N, Wrap S, Wrap T>
+inline void nearest_indices(const float* __restrict ur, const float* __restrict vr, const LevelLanes& __restrict L,
+                            std::uint32_t lanes, std::int32_t (*__restrict idx)[kMaxN], float* __restrict tx,
+                            float* __restrict ty) {
+    using texture_detail::nearest_index;
+    for (int l = 0; l < N; ++l) {
+        if (!((lanes >> l) & 1u)) continue;
+        const int x = nearest_index<S>(ur[l] * L.fw[l], L.w[l]);
+        const int y = nearest_index<T>(vr[l] * L.fh[l], L.h[l]);
+        idx[0][l] = idx[1][l] = idx[2][l] = idx[3][l] = L.offset[l] + y * L.w[l] + x;
+        tx[l] = ty[l] = 0.0f;
+    }
+}
+
 template <int N, Wrap S, Wrap T>
 inline void prepare(const float* __restrict u, const float* __restrict v, const LevelLanes& A,
                     const LevelLanes* B, TrilinearLanes& out) {
@@ -118,6 +138,10 @@ inline void prepare(const float* __restrict u, const float* __restrict v, const 
     }
     bilinear_indices<N, S, T>(ur, vr, A, out.ia, out.txa, out.tya);
     if (B) bilinear_indices<N, S, T>(ur, vr, *B, out.ib, out.txb, out.tyb);
+    if (out.nearest) {
+        nearest_indices<N, S, T>(ur, vr, A, out.nearest, out.ia, out.txa, out.tya);
+        if (B) nearest_indices<N, S, T>(ur, vr, *B, out.nearest, out.ib, out.txb, out.tyb);
+    }
 }
 
 template <int N, Wrap S>
@@ -168,11 +192,21 @@ inline void fetch_lanes_one_by_one(const Texels* const* src, const TrilinearLane
     for (std::uint32_t m = at.live; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
         Float4 c[K];
-        for (int k = 0; k < K; ++k) c[k] = bilinear(src[k], at.ia, at.txa, at.tya, l);
-        if ((at.blend >> l) & 1u) {
-            for (int k = 0; k < K; ++k) {
-                const Float4 cb = bilinear(src[k], at.ib, at.txb, at.tyb, l);
-                c[k] = c[k] + (cb - c[k]) * at.t[l];
+        if ((at.nearest >> l) & 1u) {  // the texel itself, as Texture::nearest_reduced() returns it
+            for (int k = 0; k < K; ++k) c[k] = load_texel(src[k], at.ia[0][l]);
+            if ((at.blend >> l) & 1u) {
+                for (int k = 0; k < K; ++k) {
+                    const Float4 cb = load_texel(src[k], at.ib[0][l]);
+                    c[k] = c[k] + (cb - c[k]) * at.t[l];
+                }
+            }
+        } else {
+            for (int k = 0; k < K; ++k) c[k] = bilinear(src[k], at.ia, at.txa, at.tya, l);
+            if ((at.blend >> l) & 1u) {
+                for (int k = 0; k < K; ++k) {
+                    const Float4 cb = bilinear(src[k], at.ib, at.txb, at.tyb, l);
+                    c[k] = c[k] + (cb - c[k]) * at.t[l];
+                }
             }
         }
         for (int k = 0; k < K; ++k) {
@@ -406,34 +440,50 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
     }
     int la[kMaxQuadSlots] = {};
     float t[kMaxQuadSlots] = {};
-    std::uint32_t blend_quads = 0;
+    std::uint32_t blend_quads = 0, nearest_quads = 0;
     const int last = tex.levels() - 1;
-    for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
-        const int q = __builtin_ctz(qs);
-        const float lam = lambda[q];
-        if (!(lam > 0.0f)) {
-            la[q] = 0;  // magnification, or NaN
-        } else if (lam >= float(last)) {
-            la[q] = last;
-        } else {
-            const float fl = std::floor(lam);
-            la[q] = int(fl);
-            t[q] = lam - fl;
-            if (t[q] != 0.0f) blend_quads |= 1u << q;
+    if (tex.default_filters()) {
+        for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
+            const int q = __builtin_ctz(qs);
+            const float lam = lambda[q];
+            if (!(lam > 0.0f)) {
+                la[q] = 0;  // magnification, or NaN
+            } else if (lam >= float(last)) {
+                la[q] = last;
+            } else {
+                const float fl = std::floor(lam);
+                la[q] = int(fl);
+                t[q] = lam - fl;
+                if (t[q] != 0.0f) blend_quads |= 1u << q;
+            }
+        }
+    } else {
+        for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
+            const int q = __builtin_ctz(qs);
+            const LevelChoice c = tex.choose_level(lambda[q]);
+            la[q] = c.level;
+            t[q] = c.t;
+            blend_quads |= std::uint32_t(c.blend) << q;
+            nearest_quads |= std::uint32_t(c.nearest) << q;
         }
     }
     out.live = live;
     out.blend = 0;
+    out.nearest = 0;
     if (unpacked) {
         for (int q = 0; q < 4; ++q) {
             for (int l = 4 * q; l < 4 * q + 4; ++l) out.t[l] = t[q];
             out.blend |= ((blend_quads >> q) & 1u) * (0xFu << (4 * q));
         }
+        if (nearest_quads)
+            for (int q = 0; q < 4; ++q) out.nearest |= ((nearest_quads >> q) & 1u) * (0xFu << (4 * q));
     } else {
         for (int l = 0; l < N; ++l) {
             out.t[l] = t[quad_of(l)];
             out.blend |= ((blend_quads >> quad_of(l)) & 1u) << l;
         }
+        if (nearest_quads)
+            for (int l = 0; l < N; ++l) out.nearest |= ((nearest_quads >> quad_of(l)) & 1u) << l;
     }
     out.blend &= live;
 

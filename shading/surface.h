@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -29,6 +30,18 @@ struct BoundMaterial {
     const Texture* normal = nullptr;
     const Texture* occlusion = nullptr;
     const Texture* emissive = nullptr;
+    // The UV set each map reads (TextureRef::texcoord, 0 .. kMaxUvSets - 1).
+    struct UvSets {
+        std::uint8_t base_color = 0, metallic_roughness = 0, roughness = 0, metallic = 0;
+        std::uint8_t normal = 0, occlusion = 0, emissive = 0;
+    };
+    UvSets uv = {};
+    // True when a bound map reads a UV set other than TEXCOORD_0.
+    bool reads_extra_uv_sets() const {
+        return (base_color && uv.base_color) || (metallic_roughness && uv.metallic_roughness) ||
+               (roughness && uv.roughness) || (metallic && uv.metallic) || (normal && uv.normal) ||
+               (occlusion && uv.occlusion) || (emissive && uv.emissive);
+    }
 };
 
 // Interpolated geometry at a pixel, world space.
@@ -39,6 +52,16 @@ struct SurfacePoint {
     glm::vec2 uv{0.0f};
     glm::vec2 duv_dx{0.0f}, duv_dy{0.0f};  // screen-space derivatives of uv (quad)
     bool front_facing = true;
+    // UV sets 1 .. kMaxUvSets - 1 (TEXCOORD_1 ...), with their own derivatives.
+    glm::vec2 uv_more[kMaxUvSets - 1] = {};
+    glm::vec2 duv_more_dx[kMaxUvSets - 1] = {}, duv_more_dy[kMaxUvSets - 1] = {};
+    // The interpolated vertex colour (COLOR_0, linear RGBA) when the mesh has one.
+    bool has_color = false;
+    glm::vec4 color{1.0f};
+
+    glm::vec2 uv_of(int set) const { return set == 0 ? uv : uv_more[set - 1]; }
+    glm::vec2 duv_dx_of(int set) const { return set == 0 ? duv_dx : duv_more_dx[set - 1]; }
+    glm::vec2 duv_dy_of(int set) const { return set == 0 ? duv_dy : duv_more_dy[set - 1]; }
 };
 
 // The material evaluated at a point.
@@ -116,6 +139,7 @@ struct MaterialLods {
     float normal = 0, occlusion = 0, emissive = 0;
 };
 
+// Every map with the derivatives of UV set 0.
 inline MaterialLods material_lods(const BoundMaterial& bm, glm::vec2 duv_dx, glm::vec2 duv_dy) {
     MaterialLods l;
     auto lod = [&](const Texture* t) { return t ? t->lod(duv_dx.x, duv_dx.y, duv_dy.x, duv_dy.y) : 0.0f; };
@@ -129,6 +153,25 @@ inline MaterialLods material_lods(const BoundMaterial& bm, glm::vec2 duv_dx, glm
     return l;
 }
 
+// Each map with the derivatives of the UV set it reads.
+inline MaterialLods material_lods(const BoundMaterial& bm, const SurfacePoint& sp) {
+    if (!bm.reads_extra_uv_sets()) return material_lods(bm, sp.duv_dx, sp.duv_dy);
+    MaterialLods l;
+    auto lod = [&](const Texture* t, int set) {
+        if (!t) return 0.0f;
+        const glm::vec2 dx = sp.duv_dx_of(set), dy = sp.duv_dy_of(set);
+        return t->lod(dx.x, dx.y, dy.x, dy.y);
+    };
+    l.base_color = lod(bm.base_color, bm.uv.base_color);
+    l.metallic_roughness = lod(bm.metallic_roughness, bm.uv.metallic_roughness);
+    l.roughness = lod(bm.roughness, bm.uv.roughness);
+    l.metallic = lod(bm.metallic, bm.uv.metallic);
+    l.normal = lod(bm.normal, bm.uv.normal);
+    l.occlusion = lod(bm.occlusion, bm.uv.occlusion);
+    l.emissive = lod(bm.emissive, bm.uv.emissive);
+    return l;
+}
+
 
 namespace surface_detail {
 
@@ -138,8 +181,10 @@ inline glm::vec3 safe_normalize(const glm::vec3& v, const glm::vec3& fallback) {
     return v / std::sqrt(len2);
 }
 
-inline glm::vec4 fetch(const Texture* tex, const SurfacePoint& sp, float lambda) {
-    return tex->sample_trilinear(sp.uv.x, sp.uv.y, lambda);
+// The map's own sampler at its UV set.
+inline glm::vec4 fetch(const Texture* tex, const SurfacePoint& sp, int set, float lambda) {
+    const glm::vec2 uv = sp.uv_of(set);
+    return tex->sample_lod(uv.x, uv.y, lambda);
 }
 
 } // namespace surface_detail
@@ -148,9 +193,11 @@ inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoin
     const Material& m = *bm.m;
     MaterialSample s;
 
-    // Base colour and alpha: factor times the (already linear) texture.
+    // Base colour and alpha: factor times the (already linear) texture times
+    // the vertex colour (glTF's COLOR_0).
     glm::vec4 base = m.base_color_factor;
-    if (bm.base_color) base *= surface_detail::fetch(bm.base_color, sp, lods.base_color);
+    if (bm.base_color) base *= surface_detail::fetch(bm.base_color, sp, bm.uv.base_color, lods.base_color);
+    if (sp.has_color) base *= sp.color;
     s.albedo = glm::vec3(base);
     s.ior = m.ior;
     s.conductor = m.conductor;
@@ -160,18 +207,18 @@ inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoin
     s.metallic = m.metallic_factor;
     s.roughness = m.roughness_factor;
     if (bm.metallic_roughness) {
-        glm::vec4 mr = surface_detail::fetch(bm.metallic_roughness, sp, lods.metallic_roughness);
+        glm::vec4 mr = surface_detail::fetch(bm.metallic_roughness, sp, bm.uv.metallic_roughness, lods.metallic_roughness);
         s.roughness *= mr.g;
         s.metallic *= mr.b;
     }
-    if (bm.roughness) s.roughness *= surface_detail::fetch(bm.roughness, sp, lods.roughness).r;
-    if (bm.metallic) s.metallic *= surface_detail::fetch(bm.metallic, sp, lods.metallic).r;
+    if (bm.roughness) s.roughness *= surface_detail::fetch(bm.roughness, sp, bm.uv.roughness, lods.roughness).r;
+    if (bm.metallic) s.metallic *= surface_detail::fetch(bm.metallic, sp, bm.uv.metallic, lods.metallic).r;
     s.metallic = glm::clamp(s.metallic, 0.0f, 1.0f);
     s.roughness = glm::clamp(s.roughness, 0.0f, 1.0f);
 
-    if (bm.occlusion) s.occlusion = 1.0f + m.occlusion_strength * (surface_detail::fetch(bm.occlusion, sp, lods.occlusion).r - 1.0f);
+    if (bm.occlusion) s.occlusion = 1.0f + m.occlusion_strength * (surface_detail::fetch(bm.occlusion, sp, bm.uv.occlusion, lods.occlusion).r - 1.0f);
     s.emissive = m.emissive_factor;
-    if (bm.emissive) s.emissive *= glm::vec3(surface_detail::fetch(bm.emissive, sp, lods.emissive));
+    if (bm.emissive) s.emissive *= glm::vec3(surface_detail::fetch(bm.emissive, sp, bm.uv.emissive, lods.emissive));
 
     // Geometric frame; a back face of a double-sided material flips all of it.
     glm::vec3 N = surface_detail::safe_normalize(sp.N, glm::vec3(0.0f, 0.0f, 1.0f));
@@ -186,7 +233,7 @@ inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoin
         if (glm::dot(T, T) > 0.0f) {
             float w = sp.T.w < 0.0f ? -1.0f : 1.0f;
             glm::vec3 B = glm::cross(N, T) * w;
-            glm::vec4 tx = surface_detail::fetch(bm.normal, sp, lods.normal);
+            glm::vec4 tx = surface_detail::fetch(bm.normal, sp, bm.uv.normal, lods.normal);
             glm::vec3 nt = glm::vec3(tx) * 2.0f - 1.0f;
             nt.x *= m.normal_scale;
             nt.y *= m.normal_scale;
@@ -345,7 +392,7 @@ inline glm::vec3 shade_surface(const MaterialSample& ms, const SurfacePoint& sp,
 
 
 inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoint& sp) {
-    return sample_material(bm, sp, material_lods(bm, sp.duv_dx, sp.duv_dy));
+    return sample_material(bm, sp, material_lods(bm, sp));
 }
 
 } // namespace prast

@@ -271,13 +271,44 @@ const Texture::Sampler Texture::kTrilinear[3][3] = {
     {&Texture::trilinear_wrapped<kR, kR>, &Texture::trilinear_wrapped<kR, kC>, &Texture::trilinear_wrapped<kR, kM>},
     {&Texture::trilinear_wrapped<kC, kR>, &Texture::trilinear_wrapped<kC, kC>, &Texture::trilinear_wrapped<kC, kM>},
     {&Texture::trilinear_wrapped<kM, kR>, &Texture::trilinear_wrapped<kM, kC>, &Texture::trilinear_wrapped<kM, kM>}};
+const Texture::Sampler Texture::kFiltered[3][3] = {
+    {&Texture::filtered_wrapped<kR, kR>, &Texture::filtered_wrapped<kR, kC>, &Texture::filtered_wrapped<kR, kM>},
+    {&Texture::filtered_wrapped<kC, kR>, &Texture::filtered_wrapped<kC, kC>, &Texture::filtered_wrapped<kC, kM>},
+    {&Texture::filtered_wrapped<kM, kR>, &Texture::filtered_wrapped<kM, kC>, &Texture::filtered_wrapped<kM, kM>}};
+const Texture::LevelSampler Texture::kNearest[3][3] = {
+    {&Texture::nearest_wrapped<kR, kR>, &Texture::nearest_wrapped<kR, kC>, &Texture::nearest_wrapped<kR, kM>},
+    {&Texture::nearest_wrapped<kC, kR>, &Texture::nearest_wrapped<kC, kC>, &Texture::nearest_wrapped<kC, kM>},
+    {&Texture::nearest_wrapped<kM, kR>, &Texture::nearest_wrapped<kM, kC>, &Texture::nearest_wrapped<kM, kM>}};
 const Texture::LevelSampler Texture::kBilinear[3][3] = {
     {&Texture::bilinear_wrapped<kR, kR>, &Texture::bilinear_wrapped<kR, kC>, &Texture::bilinear_wrapped<kR, kM>},
     {&Texture::bilinear_wrapped<kC, kR>, &Texture::bilinear_wrapped<kC, kC>, &Texture::bilinear_wrapped<kC, kM>},
     {&Texture::bilinear_wrapped<kM, kR>, &Texture::bilinear_wrapped<kM, kC>, &Texture::bilinear_wrapped<kM, kM>}};
 
+void Texture::set_sampler(const SamplerState& s) {
+    sampler_ = s;
+    default_filters_ = s.mag == Filter::Linear && s.min == MinFilter::LinearMipmapLinear;
+    // OpenGL's switch-over point c: 0.5 when magnifying LINEAR beside a
+    // NEAREST_MIPMAP_* minification, so that a minified texture is never
+    // sharper than a magnified one; 0 otherwise.
+    min_mag_c_ = s.mag == Filter::Linear &&
+                         (s.min == MinFilter::NearestMipmapNearest || s.min == MinFilter::NearestMipmapLinear)
+                     ? 0.5f
+                     : 0.0f;
+    sample_fn_ = default_filters_ ? kTrilinear[int(s.wrap_s)][int(s.wrap_t)] : kFiltered[int(s.wrap_s)][int(s.wrap_t)];
+    sampler_key_ = unsigned(s.wrap_s) | unsigned(s.wrap_t) << 2 | unsigned(s.mag) << 4 | unsigned(s.min) << 5;
+}
+
+Texture Texture::with_sampler(const SamplerState& s) const {
+    Texture t = *this;
+    t.set_sampler(s);
+    return t;
+}
+
 Texture::Texture() {
-    texels_.assign(1, glm::vec4(1.0f));
+    auto st = std::make_shared<Storage>();
+    st->texels.assign(1, glm::vec4(1.0f));
+    texels_ = st->texels.data();
+    storage_ = std::move(st);
     levels_[0] = Level{1, 1, 1.0f, 1.0f, 0};
     level_count_ = 1;
     total_texels_ = 1;
@@ -325,32 +356,33 @@ Texture Texture::from_image(Image img, Wrap s, Wrap t, ThreadPool* pool) {
                                     std::to_string(img.rgba.size()) + " floats, expected " +
                                     std::to_string(count0 * 4));
     Texture tex;
-    tex.wrap_s_ = s;
-    tex.wrap_t_ = t;
+    tex.set_sampler(SamplerState{s, t});
     tex.layout(img.width, img.height);
 
     // Level 0 is the image; each further level is the box-filtered one above.
-    tex.texels_.resize(tex.total_texels_);
-    std::memcpy(static_cast<void*>(tex.texels_.data()), img.rgba.data(), count0 * sizeof(glm::vec4));
+    auto st = std::make_shared<Storage>();
+    st->texels.resize(tex.total_texels_);
+    std::memcpy(static_cast<void*>(st->texels.data()), img.rgba.data(), count0 * sizeof(glm::vec4));
     img = Image();  // release the source before the chain needs its scratch rows
     for (int l = 1; l < tex.level_count_; ++l) {
         const Level& a = tex.levels_[l - 1];
         const Level& b = tex.levels_[l];
-        glm::vec4* base = tex.texels_.data();
+        glm::vec4* base = st->texels.data();
         for_row_chunks(pool, b.height, std::size_t(b.width), [&](int j0, int j1) {
             std::vector<glm::vec4> tmp;
             downsample(base + a.offset, a.width, a.height, base + b.offset, b.width, j0, j1, tmp);
         });
     }
     tex.memory_bytes_ = tex.total_texels_ * sizeof(glm::vec4);
+    tex.texels_ = st->texels.data();
+    tex.storage_ = std::move(st);
     return tex;
 }
 
 Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const float* const tables[4],
                              const int swizzle[4], int w, int h, Wrap s, Wrap t, ThreadPool* pool) {
     Texture tex;
-    tex.wrap_s_ = s;
-    tex.wrap_t_ = t;
+    tex.set_sampler(SamplerState{s, t});
     tex.channels_ = channels;
     bool srgb_channel[4] = {false, false, false, false};
     for (int c = 0; c < 4; ++c) {
@@ -362,8 +394,9 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const flo
     const std::size_t C = std::size_t(channels);
     // Spare bytes: the block sampler reads 4 or 8 bytes at any texel.
     const std::size_t bytes = tex.total_texels_ * C + kReadSlack;
-    tex.bytes_.reset(allocate_texels(bytes));
-    std::uint8_t* base = tex.bytes_.get();
+    auto st = std::make_shared<Storage>();
+    st->bytes.reset(allocate_texels(bytes));
+    std::uint8_t* base = st->bytes.get();
     std::memset(base + tex.total_texels_ * C, 0, kReadSlack);
     if (level0) std::memcpy(base, level0, std::size_t(w) * std::size_t(h) * C);
     for (int l = 1; l < tex.level_count_; ++l) {
@@ -375,6 +408,8 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const flo
         });
     }
     tex.memory_bytes_ = tex.total_texels_ * C;
+    tex.bytes_ = base;
+    tex.storage_ = std::move(st);
     return tex;
 }
 

@@ -17,6 +17,20 @@
 // (sRGB channels are decoded, filtered, and re-encoded). Float images (HDR,
 // 16-bit, procedural) keep float RGBA texels and float mips.
 //
+// A Texture is the decoded storage (shared, immutable) seen through one
+// sampler: its wrap modes and its glTF/OpenGL filters. with_sampler() gives
+// another view of the same texels, so one decoded image serves every texture
+// that names it, each with its own sampler. The storage's layout is private to
+// this class and sample_lanes.h (texel indices through level_offset()).
+//
+// Filters follow OpenGL (the rules glTF samplers name): magnification when
+// lambda <= c, with c = 0.5 for magFilter LINEAR with minFilter
+// NEAREST_MIPMAP_NEAREST or NEAREST_MIPMAP_LINEAR and c = 0 otherwise;
+// NEAREST takes texel (floor(u w), floor(v h)) wrapped; the MIPMAP_NEAREST
+// modes read level d = ceil(lambda + 1/2) - 1 clamped to the chain; the
+// MIPMAP_LINEAR modes blend levels floor(lambda) and floor(lambda) + 1 by the
+// fraction. The default (LINEAR, LINEAR_MIPMAP_LINEAR) is sample_trilinear().
+//
 // A Texture is immutable after construction and is shared read-only between
 // render threads: no caches, no allocation and no virtual calls when sampling.
 #pragma once
@@ -36,6 +50,30 @@
 namespace prast {
 
 class ThreadPool;
+
+// A texture's sampler: wrap modes and filters (defaults: trilinear, repeat).
+struct SamplerState {
+    Wrap wrap_s = Wrap::Repeat, wrap_t = Wrap::Repeat;
+    Filter mag = Filter::Linear;
+    MinFilter min = MinFilter::LinearMipmapLinear;
+    bool operator==(const SamplerState& o) const {
+        return wrap_s == o.wrap_s && wrap_t == o.wrap_t && mag == o.mag && min == o.min;
+    }
+    bool operator!=(const SamplerState& o) const { return !(*this == o); }
+};
+
+inline SamplerState sampler_of(const TextureRef& r) {
+    return SamplerState{r.wrap_s, r.wrap_t, r.mag_filter, r.min_filter};
+}
+
+// Where a lookup reads: level `level` (and level + 1 blended by t when
+// `blend`), with the NEAREST texel or the bilinear footprint in each.
+struct LevelChoice {
+    int level = 0;
+    float t = 0.0f;
+    bool blend = false;
+    bool nearest = false;
+};
 
 class Texture {
 public:
@@ -65,11 +103,21 @@ public:
     static Texture pack_roughness_metal(const Image& rough, const Image& metal, Wrap s = Wrap::Repeat,
                                         Wrap t = Wrap::Repeat, ThreadPool* pool = nullptr);
 
+    // The same storage (shared, not copied) seen through another sampler.
+    Texture with_sampler(const SamplerState& s) const;
+    // True when a and b hold the same decoded storage.
+    bool shares_storage(const Texture& o) const { return storage_ == o.storage_; }
+
     int levels() const { return level_count_; }
     int width(int level) const { return levels_[clamp_level(level)].width; }
     int height(int level) const { return levels_[clamp_level(level)].height; }
-    Wrap wrap_s() const { return wrap_s_; }
-    Wrap wrap_t() const { return wrap_t_; }
+    Wrap wrap_s() const { return sampler_.wrap_s; }
+    Wrap wrap_t() const { return sampler_.wrap_t; }
+    const SamplerState& sampler() const { return sampler_; }
+    // LINEAR / LINEAR_MIPMAP_LINEAR: sample_lod() is sample_trilinear().
+    bool default_filters() const { return default_filters_; }
+    // Wrap modes and filters in one number: equal keys sample alike.
+    unsigned sampler_key() const { return sampler_key_; }
 
     // One stored texel as linear RGBA; the level and coordinates are clamped to
     // the valid range.
@@ -93,8 +141,8 @@ public:
     const float* table(int c) const { return table_[c]; }
     // The texels of every level, level 0 first, each row-major; level k starts
     // at texel level_offset(k). For the 4x4-block sampler (sample_lanes.h).
-    const glm::vec4* texel_data() const { return texels_.data(); }
-    const std::uint8_t* unorm8_data() const { return bytes_.get(); }
+    const glm::vec4* texel_data() const { return texels_; }
+    const std::uint8_t* unorm8_data() const { return bytes_; }
     std::size_t level_offset(int level) const { return levels_[clamp_level(level)].offset; }
     // Bytes held by the texels of all levels.
     std::size_t memory_bytes() const { return memory_bytes_; }
@@ -110,9 +158,17 @@ public:
     // linear blend of the bilinear results of levels floor(lambda) and
     // floor(lambda) + 1, clamped to the last level.
     glm::vec4 sample_trilinear(float u, float v, float lambda) const;
-    // sample_trilinear(u, v, lod(...)).
+    // The texel NEAREST to (u, v) on one level (clamped to the valid range).
+    glm::vec4 sample_nearest(float u, float v, int level) const;
+    // The levels and filter the sampler's filters choose at lambda (file
+    // comment); NaN lambda magnifies.
+    LevelChoice choose_level(float lambda) const;
+    // The lookup the sampler's filters define at lambda: sample_trilinear()
+    // for the default filters.
+    glm::vec4 sample_lod(float u, float v, float lambda) const { return (this->*sample_fn_)(u, v, lambda); }
+    // sample_lod(u, v, lod(...)).
     glm::vec4 sample(float u, float v, float dudx, float dvdx, float dudy, float dvdy) const {
-        return sample_trilinear(u, v, lod(dudx, dvdx, dudy, dvdy));
+        return sample_lod(u, v, lod(dudx, dvdx, dudy, dvdy));
     }
 
 private:
@@ -130,10 +186,16 @@ private:
     template <Wrap S, Wrap T> glm::vec4 bilinear_reduced(float u, float v, int level) const;
     template <Wrap S, Wrap T> glm::vec4 bilinear_wrapped(float u, float v, int level) const;
     template <Wrap S, Wrap T> glm::vec4 trilinear_wrapped(float u, float v, float lambda) const;
+    template <Wrap S, Wrap T> glm::vec4 nearest_reduced(float u, float v, int level) const;
+    template <Wrap S, Wrap T> glm::vec4 nearest_wrapped(float u, float v, int level) const;
+    template <Wrap S, Wrap T> glm::vec4 filtered_wrapped(float u, float v, float lambda) const;
     using Sampler = glm::vec4 (Texture::*)(float, float, float) const;
     using LevelSampler = glm::vec4 (Texture::*)(float, float, int) const;
     static const Sampler kTrilinear[3][3];
+    static const Sampler kFiltered[3][3];
     static const LevelSampler kBilinear[3][3];
+    static const LevelSampler kNearest[3][3];
+    void set_sampler(const SamplerState& s);
 
     // Lays out the chain for a w x h level 0.
     void layout(int w, int h);
@@ -143,8 +205,14 @@ private:
     struct FreeBytes {
         void operator()(std::uint8_t* p) const { std::free(p); }
     };
-    std::vector<glm::vec4> texels_;  // float storage: all levels, level 0 first, row-major
-    std::unique_ptr<std::uint8_t[], FreeBytes> bytes_;  // 8-bit storage, same order
+    // The texels, shared by every view of one decoded image.
+    struct Storage {
+        std::vector<glm::vec4> texels;  // float storage: all levels, level 0 first, row-major
+        std::unique_ptr<std::uint8_t[], FreeBytes> bytes;  // 8-bit storage, same order
+    };
+    std::shared_ptr<const Storage> storage_;
+    const glm::vec4* texels_ = nullptr;   // storage_->texels
+    const std::uint8_t* bytes_ = nullptr; // storage_->bytes
     int channels_ = 0;               // 0: float storage
     int swizzle_[4] = {0, 1, 2, 3};
     const float* table_[4] = {nullptr, nullptr, nullptr, nullptr};
@@ -152,7 +220,11 @@ private:
     std::size_t memory_bytes_ = 0;
     Level levels_[kMaxLevels];
     int level_count_ = 0;
-    Wrap wrap_s_ = Wrap::Repeat, wrap_t_ = Wrap::Repeat;
+    SamplerState sampler_;
+    Sampler sample_fn_ = &Texture::trilinear_wrapped<Wrap::Repeat, Wrap::Repeat>;
+    float min_mag_c_ = 0.0f;         // magnification when lambda <= c
+    bool default_filters_ = true;
+    unsigned sampler_key_ = 0;
 };
 
 // ---- Inline sampling (the per-pixel hot path).
@@ -172,6 +244,20 @@ inline float reduce(float c) {
     if constexpr (W == Wrap::MirroredRepeat) return c - 2.0f * std::floor(c * 0.5f);
     c = c < 0.0f ? 0.0f : c;
     return c > 1.0f ? 1.0f : c;
+}
+
+// The NEAREST texel of a reduced coordinate x = reduce<W>(c) * n, i.e.
+// floor(c n) wrapped, into [0, n). Repeat and ClampToEdge reach n only when
+// the true index is n - 1 (a tiny negative c folds to 1; c n rounding up to
+// n); MirroredRepeat reaches 2n only from a tiny negative c (texel 0).
+template <Wrap W>
+inline int nearest_index(float x, int n) {
+    const int i = int(std::floor(x));
+    if constexpr (W == Wrap::MirroredRepeat) {
+        const int j = i >= 2 * n ? i - 2 * n : i;
+        return j >= n ? 2 * n - 1 - j : j;
+    }
+    return i >= n ? n - 1 : i;
 }
 
 // Maps a texel index in [-1, 2n] (guaranteed by reduce()) into [0, n).
@@ -235,20 +321,83 @@ inline glm::vec4 Texture::trilinear_wrapped(float u, float v, float lambda) cons
     return a + (bilinear_reduced<S, T>(ur, vr, l0 + 1) - a) * t;
 }
 
+template <Wrap S, Wrap T>
+inline glm::vec4 Texture::nearest_reduced(float u, float v, int level) const {
+    const Level& L = levels_[level];
+    const int x = texture_detail::nearest_index<S>(u * L.fwidth, L.width);
+    const int y = texture_detail::nearest_index<T>(v * L.fheight, L.height);
+    return texel_at(L.offset + std::size_t(y) * std::size_t(L.width) + std::size_t(x));
+}
+
+template <Wrap S, Wrap T>
+inline glm::vec4 Texture::nearest_wrapped(float u, float v, int level) const {
+    return nearest_reduced<S, T>(texture_detail::reduce<S>(u), texture_detail::reduce<T>(v), clamp_level(level));
+}
+
+inline LevelChoice Texture::choose_level(float lambda) const {
+    LevelChoice c;
+    if (!(lambda > min_mag_c_)) {  // magnification, or NaN
+        c.nearest = sampler_.mag == Filter::Nearest;
+        return c;
+    }
+    const int last = level_count_ - 1;
+    switch (sampler_.min) {
+    case MinFilter::Nearest: c.nearest = true; return c;
+    case MinFilter::Linear: return c;
+    case MinFilter::NearestMipmapNearest:
+    case MinFilter::LinearMipmapNearest: {
+        // ceil(lambda + 1/2) - 1 == ceil(lambda - 1/2), and lambda - 0.5f is
+        // exact for lambda >= 0.25 (both are multiples of lambda's ulp).
+        const float d = std::ceil(lambda - 0.5f);
+        c.level = d <= 0.0f ? 0 : (d >= float(last) ? last : int(d));
+        c.nearest = sampler_.min == MinFilter::NearestMipmapNearest;
+        return c;
+    }
+    case MinFilter::NearestMipmapLinear:
+    case MinFilter::LinearMipmapLinear:
+        c.nearest = sampler_.min == MinFilter::NearestMipmapLinear;
+        if (lambda >= float(last)) {
+            c.level = last;
+            return c;
+        }
+        const float fl = std::floor(lambda);
+        c.level = int(fl);
+        c.t = lambda - fl;
+        c.blend = c.t != 0.0f;
+        return c;
+    }
+    return c;
+}
+
+template <Wrap S, Wrap T>
+inline glm::vec4 Texture::filtered_wrapped(float u, float v, float lambda) const {
+    const float ur = texture_detail::reduce<S>(u), vr = texture_detail::reduce<T>(v);
+    const LevelChoice c = choose_level(lambda);
+    const glm::vec4 a = c.nearest ? nearest_reduced<S, T>(ur, vr, c.level) : bilinear_reduced<S, T>(ur, vr, c.level);
+    if (!c.blend) return a;
+    const glm::vec4 b =
+        c.nearest ? nearest_reduced<S, T>(ur, vr, c.level + 1) : bilinear_reduced<S, T>(ur, vr, c.level + 1);
+    return a + (b - a) * c.t;
+}
+
 inline glm::vec4 Texture::texel_at(std::size_t i) const {
     if (channels_ == 0) return texels_[i];
-    const std::uint8_t* p = bytes_.get() + i * std::size_t(channels_);
+    const std::uint8_t* p = bytes_ + i * std::size_t(channels_);
     float c[5] = {0.0f, 0.0f, 0.0f, 0.0f, 1.0f};
     for (int k = 0; k < channels_; ++k) c[k] = table_[k][p[k]];
     return {c[swizzle_[0]], c[swizzle_[1]], c[swizzle_[2]], c[swizzle_[3]]};
 }
 
 inline glm::vec4 Texture::sample_bilinear(float u, float v, int level) const {
-    return (this->*kBilinear[int(wrap_s_)][int(wrap_t_)])(u, v, level);
+    return (this->*kBilinear[int(sampler_.wrap_s)][int(sampler_.wrap_t)])(u, v, level);
+}
+
+inline glm::vec4 Texture::sample_nearest(float u, float v, int level) const {
+    return (this->*kNearest[int(sampler_.wrap_s)][int(sampler_.wrap_t)])(u, v, level);
 }
 
 inline glm::vec4 Texture::sample_trilinear(float u, float v, float lambda) const {
-    return (this->*kTrilinear[int(wrap_s_)][int(wrap_t_)])(u, v, lambda);
+    return (this->*kTrilinear[int(sampler_.wrap_s)][int(sampler_.wrap_t)])(u, v, lambda);
 }
 
 inline float Texture::lod(float dudx, float dvdx, float dudy, float dvdy) const {

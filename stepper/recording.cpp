@@ -271,7 +271,7 @@ void record_frame(FrameSetup& s, Recording& rec) {
     rec.visibility = s.settings.visibility;
     std::size_t total = 0;
     for (const Mesh& m : s.scene.meshes)
-        if (!m.indices.empty()) total += m.indices.size() / 3;
+        if (m.topology == Mesh::Topology::Triangles) total += m.indices.size() / 3;
     rec.triangles.resize(total);
     rec.fb.resize(rec.width, rec.height);
 

@@ -81,7 +81,7 @@ void replay_block(const FrameSetup& s, const Recording& rec, const BlockRecord& 
     float v[3][kStride];
     piece_vertices(s, rec, b.piece, v);
     constexpr int NV = kPbrVaryings;
-    detail::TriangleVaryings<NV> pv;  // as prepare_varyings() makes them
+    raster_detail::TriangleVaryings<NV> pv;  // as prepare_varyings() makes them
     for (int k = 0; k < NV; ++k) {
         pv.v0[k] = v[0][4 + k];
         pv.d1[k] = v[1][4 + k] - v[0][4 + k];
@@ -91,8 +91,8 @@ void replay_block(const FrameSetup& s, const Recording& rec, const BlockRecord& 
     const SamplePattern& sp = sample_pattern(rec.samples);
     const std::uint32_t lanes = b.shaded ? b.shaded : b.pass;  // the lanes the shader ran for
     // The rasterizer's own interpolation (shade.h), centroids included.
-    if (rec.samples > 1) detail::interpolate_block<true, NV>(t, pv, sp, b.bx, b.by, lanes, nullptr, in);
-    else detail::interpolate_block<false, NV>(t, pv, sp, b.bx, b.by, lanes, nullptr, in);
+    if (rec.samples > 1) raster_detail::interpolate_block<true, NV>(t, pv, sp, b.bx, b.by, lanes, nullptr, in);
+    else raster_detail::interpolate_block<false, NV>(t, pv, sp, b.bx, b.by, lanes, nullptr, in);
     in.x = b.bx;
     in.y = b.by;
     in.mask = lanes;

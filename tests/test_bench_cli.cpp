@@ -73,7 +73,7 @@ TEST_CASE("bench: writes its workloads and measures them, in text, JSON, alterna
     CHECK(grid_png.width == 1920);
     CHECK(grid_png.height == 1080);
 
-    // --json: one object per workload with the figures the README's tables use.
+    // --json: one object per workload with the figures docs/performance.md's table uses.
     CliRun j = box.run_exe(PRAST_BENCH_EXE, {"--workloads", dir, "--workload", "grid,bottle", "--threads", "1",
                                              "--repeat", "2", "--json"});
     REQUIRE(j.code == 0);

@@ -1,4 +1,4 @@
-// Hostile input (issue 12): every class of attack the issue lists, each made
+// Hostile input: every class of attack we know of, each made
 // by the test itself in a scratch directory and run where a user meets it,
 // mostly through the built `render` binary: references that leave the
 // model's folder (../, percent-encoded, backslashes, absolute, symbolic

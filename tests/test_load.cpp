@@ -109,18 +109,29 @@ void check_sane(const Scene& scene) {
     std::size_t bad_index = 0, bad_position = 0, bad_normal = 0, bad_uv = 0, bad_tangent = 0, bad_image = 0;
     for (const Mesh& m : scene.meshes) {
         const std::size_t n = m.positions.size();
-        REQUIRE(m.normals.size() == n);
+        const bool triangles = m.topology == Mesh::Topology::Triangles;
+        const std::size_t corners = triangles ? 3 : m.topology == Mesh::Topology::Lines ? 2 : 1;
+        // Lines and points may come without normals (drawn unlit), and then without tangents.
+        REQUIRE((m.normals.size() == n || (!triangles && m.normals.empty())));
         REQUIRE((m.uvs.empty() || m.uvs.size() == n));
-        REQUIRE(m.tangents.size() == (m.uvs.empty() ? 0 : n));
+        REQUIRE((m.uvs1.empty() || m.uvs1.size() == n));
+        REQUIRE((m.colors.empty() || m.colors.size() == n));
+        REQUIRE((m.tangents.empty() || m.tangents.size() == n));
+        if (!m.uvs.empty() && !m.normals.empty()) REQUIRE(m.tangents.size() == n);
+        if (m.uvs.empty() && m.uvs1.empty()) REQUIRE(m.tangents.empty());
         REQUIRE(!m.indices.empty());
-        REQUIRE(m.indices.size() % 3 == 0);
+        REQUIRE(m.indices.size() % corners == 0);
         REQUIRE(m.material >= 0);
         REQUIRE(std::size_t(m.material) < scene.materials.size());
         for (std::uint32_t i : m.indices) bad_index += i >= n;
         for (std::size_t i = 0; i < n; ++i) {
             bad_position += !finite(m.positions[i]);
-            bad_normal += !finite(m.normals[i]) || std::abs(glm::length(m.normals[i]) - 1.0f) > 1e-3f;
+            if (!m.normals.empty())
+                bad_normal += !finite(m.normals[i]) || std::abs(glm::length(m.normals[i]) - 1.0f) > 1e-3f;
             if (!m.uvs.empty()) bad_uv += !std::isfinite(m.uvs[i].x) || !std::isfinite(m.uvs[i].y);
+            if (!m.colors.empty())
+                bad_uv += !(glm::all(glm::greaterThanEqual(m.colors[i], glm::vec4(0.0f))) &&
+                            glm::all(glm::lessThanEqual(m.colors[i], glm::vec4(1.0f))));
             if (!m.tangents.empty()) {
                 const glm::vec3 t(m.tangents[i]);
                 bad_tangent += !finite(t) || std::abs(glm::length(t) - 1.0f) > 1e-3f ||
@@ -752,7 +763,7 @@ TEST_CASE("glTF: recoverable problems are warnings") {
         CHECK(fs::path(s.images[0].path).filename() == "tex a.png");
         CHECK(s.images[0].bytes.empty());
     }
-    SUBCASE("BLEND, texCoord 1, KHR_materials_*, points, bad material") {
+    SUBCASE("BLEND, texCoord 1 without TEXCOORD_1, KHR_materials_*, points, bad material") {
         std::string json = quad_gltf();
         replace_once(json, "\"MASK\"", "\"BLEND\"");
         replace_once(json, "\"normalTexture\": {\"index\": 1,", "\"normalTexture\": {\"index\": 1, \"texCoord\": 1,");
@@ -766,12 +777,16 @@ TEST_CASE("glTF: recoverable problems are warnings") {
         check_sane(s);
         CHECK(s.materials[0].alpha_mode == AlphaMode::Blend);
         CHECK(!any_warning(s, "BLEND"));
-        CHECK(!s.materials[0].normal.valid());
-        CHECK(any_warning(s, "TEXCOORD_1"));
+        CHECK(s.materials[0].normal.valid());
+        CHECK(s.materials[0].normal.texcoord == 1);
+        CHECK(any_warning(s, "mesh 0 primitive 0: its material reads TEXCOORD_1, which it lacks (sampled at 0, 0)"));
+        CHECK(s.meshes[0].tangents.size() == 4);  // from TEXCOORD_0, the set the mesh has
         CHECK(any_warning(s, "KHR_materials_clearcoat"));
-        CHECK(any_warning(s, "mode 0"));
+        CHECK(!any_warning(s, "mode 0"));
         CHECK(any_warning(s, "material 7"));
-        CHECK(s.meshes.size() == 2); // the point primitive is skipped
+        REQUIRE(s.meshes.size() == 3); // the point primitive is drawn as points
+        CHECK(s.meshes[1].topology == Mesh::Topology::Points);
+        CHECK(s.meshes[1].normals.empty());
         CHECK(s.materials.size() == 2); // the bad index gets a default material
         for (const std::string& w : s.warnings) CHECK(contains(w, "warn.gltf"));
     }

@@ -1,6 +1,6 @@
-// The `render` executable end to end (issue 4): every flag through the built
+// The `render` executable end to end: every flag through the built
 // binary, checked by exit code, message and output image; determinism across
-// threads, tiles and frame ranges; every bad input of the issue; the static
+// threads, tiles and frame ranges; every kind of bad input; the static
 // link. Also the option parser directly (apps/render_options.h).
 
 // GCC 12 reports -Wmaybe-uninitialized inside libstdc++'s <regex> (its
@@ -59,7 +59,7 @@ TEST_SUITE("cli") {
 
 // ---------------------------------------------------------------- parsing
 
-TEST_CASE("parser: defaults are the issue's") {
+TEST_CASE("parser: the documented defaults") {
     RenderOptions o;
     REQUIRE(parse("", o) == "");
     CHECK(o.scene.empty());
@@ -960,7 +960,7 @@ TEST_CASE("real assets: the tea set (glTF and OBJ) and the bunny") {
         return;
     }
     CliSandbox box;
-    // The README's camera for the whole set, 4:3.
+    // The camera the shared assets' README gives for the whole set, 4:3.
     const std::vector<std::string> camera = {"--size", "160x120", "--eye", "0.02,0.60,1.35", "--target",
                                              "0.02,0.04,-0.04", "--up", "0,1,0", "--fov", "32"};
     for (const fs::path& scene : {gltf, obj}) {

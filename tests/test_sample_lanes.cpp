@@ -1,9 +1,10 @@
 // The 4x4-block texture sampler (sample_lanes.h) and material sampling
-// (material_lanes.h) against the scalar Texture::sample_trilinear() and
-// sample_material(): they must agree bit for bit, for every wrap mode, level
-// count, level of detail and coordinate (NaN and infinities included), with
-// the block unpacked (16 lanes) or its live lanes packed into 4 or 8. Then the
-// whole lit path of PbrProgram::fragment() against the scalar functions.
+// (material_lanes.h) against the scalar Texture::sample_trilinear() /
+// sample_lod() and sample_material(): they must agree bit for bit, for every
+// wrap mode, filter, level count, level of detail and coordinate (NaN and
+// infinities included), with the block unpacked (16 lanes) or its live lanes
+// packed into 4 or 8, with UV set 1 and vertex colours. Then the whole lit
+// path of PbrProgram::fragment() against the scalar functions.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -106,14 +107,28 @@ struct Packing {
     }
 };
 
+const Filter kFilters[2] = {Filter::Nearest, Filter::Linear};
+const MinFilter kMinFilters[6] = {MinFilter::Nearest, MinFilter::Linear, MinFilter::NearestMipmapNearest,
+                                  MinFilter::LinearMipmapNearest, MinFilter::NearestMipmapLinear,
+                                  MinFilter::LinearMipmapLinear};
+
+SamplerState random_sampler(std::mt19937& rng, Wrap s, Wrap t) {
+    std::uniform_int_distribution<int> mag(0, 1), min(0, 5);
+    return SamplerState{s, t, kFilters[mag(rng)], kMinFilters[min(rng)]};
+}
+
+// filtered: the texture gets a random sampler (else trilinear), and `fixed`
+// when given.
 template <int N>
-void check_sampler(std::uint32_t seed) {
+void check_sampler(std::uint32_t seed, bool filtered = false, const SamplerState* fixed = nullptr) {
     std::mt19937 rng(seed);
     const Wrap wraps[3] = {Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat};
     std::uniform_int_distribution<int> size_pick(0, 7), wrap_pick(0, 2);
     const int sizes[8] = {1, 2, 3, 5, 8, 17, 32, 64};
     const int w = sizes[size_pick(rng)], h = sizes[size_pick(rng)];
-    const Texture tex = random_texture(rng, w, h, wraps[wrap_pick(rng)], wraps[wrap_pick(rng)]);
+    Texture tex = random_texture(rng, w, h, wraps[wrap_pick(rng)], wraps[wrap_pick(rng)]);
+    if (fixed) tex = tex.with_sampler(*fixed);
+    else if (filtered) tex = tex.with_sampler(random_sampler(rng, tex.wrap_s(), tex.wrap_t()));
 
     Packing<N> pk(rng);
     alignas(64) float u[kBlockLanes], v[kBlockLanes], block_u[kBlockLanes], block_v[kBlockLanes];
@@ -134,9 +149,10 @@ void check_sampler(std::uint32_t seed) {
     fetch_trilinear_lanes<N>(tex, at, out);
     for (int l = 0; l < N; ++l) {
         if (!((pk.live >> l) & 1u)) continue;
-        const glm::vec4 ref = tex.sample_trilinear(u[l], v[l], lambda[pk.quad[l]]);
+        const glm::vec4 ref = filtered || fixed ? tex.sample_lod(u[l], v[l], lambda[pk.quad[l]])
+                                                : tex.sample_trilinear(u[l], v[l], lambda[pk.quad[l]]);
         INFO("seed ", seed, " N ", N, " lane ", l, " size ", w, "x", h, " uv ", u[l], ",", v[l],
-             " lambda ", lambda[pk.quad[l]]);
+             " lambda ", lambda[pk.quad[l]], " sampler key ", tex.sampler_key());
         CHECK(bits(out.r[l]) == bits(ref.r));
         CHECK(bits(out.g[l]) == bits(ref.g));
         CHECK(bits(out.b[l]) == bits(ref.b));
@@ -144,8 +160,10 @@ void check_sampler(std::uint32_t seed) {
     }
 }
 
+// extended: random samplers on the maps, each map on UV set 0 or 1, and a
+// vertex colour.
 template <int N>
-void check_material(std::uint32_t seed) {
+void check_material(std::uint32_t seed, bool extended = false) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> uni(0.0f, 1.0f), sym(-1.0f, 1.0f);
     std::uniform_int_distribution<int> coin(0, 1), pick(0, 9);
@@ -158,6 +176,9 @@ void check_material(std::uint32_t seed) {
     for (int i = 0; i < 7; ++i)
         textures.push_back(coin(rng) ? random_texture(rng, 16, 16, ws, wt)
                                      : random_texture(rng, 8, 32, wraps[wrap_pick(rng)], Wrap::Repeat));
+    if (extended)  // half of them through another sampler of the same texels
+        for (Texture& t : textures)
+            if (coin(rng)) t = t.with_sampler(random_sampler(rng, t.wrap_s(), t.wrap_t()));
     Material m;
     m.base_color_factor = {uni(rng), uni(rng), uni(rng), uni(rng)};
     m.metallic_factor = 1.5f * uni(rng) - 0.2f;  // the clamps to [0, 1] matter
@@ -170,6 +191,12 @@ void check_material(std::uint32_t seed) {
     m.alpha_cutoff = uni(rng);
     BoundMaterial bm;
     bm.m = &m;
+    if (extended) {
+        std::uint8_t* sets[7] = {&bm.uv.base_color, &bm.uv.metallic_roughness, &bm.uv.roughness, &bm.uv.metallic,
+                                 &bm.uv.normal, &bm.uv.occlusion, &bm.uv.emissive};
+        for (std::uint8_t* set : sets) *set = std::uint8_t(coin(rng));
+        if (coin(rng)) m.alpha_mode = AlphaMode::Blend;
+    }
     const Texture** slots[7] = {&bm.base_color, &bm.metallic_roughness, &bm.roughness, &bm.metallic,
                                 &bm.normal, &bm.occlusion, &bm.emissive};
     for (int i = 0; i < 7; ++i)
@@ -181,10 +208,19 @@ void check_material(std::uint32_t seed) {
     // tangents exercise the fallbacks.
     Packing<N> pk(rng);
     const bool front = coin(rng);
-    alignas(64) float var[12][kBlockLanes];
+    // 0-11 the narrow layout, 12-13 UV set 1, 14-17 the colour.
+    alignas(64) float var[18][kBlockLanes];
     const float du = 0.05f * sym(rng), dv = 0.05f * sym(rng);
     const float u0 = 2.0f * sym(rng), v0 = 2.0f * sym(rng);
+    const float du1 = extended ? 0.2f * sym(rng) : 0.0f, dv1 = extended ? 0.01f * sym(rng) : 0.0f;
     for (int l = 0; l < kBlockLanes; ++l) {
+        var[12][l] = var[13][l] = 0.0f;
+        for (int k = 14; k < 18; ++k) var[k][l] = 1.0f;
+        if (extended) {
+            var[12][l] = 1.0f + du1 * float(lane_x(l)) + 0.01f * sym(rng);
+            var[13][l] = -0.5f + dv1 * float(lane_y(l)) + 0.01f * sym(rng);
+            for (int k = 14; k < 18; ++k) var[k][l] = 1.2f * uni(rng);
+        }
         for (int k = 0; k < 3; ++k) var[k][l] = 3.0f * sym(rng);
         for (int k = 3; k < 6; ++k) var[k][l] = sym(rng);
         var[6][l] = u0 + du * float(lane_x(l)) + 0.01f * sym(rng);
@@ -198,8 +234,8 @@ void check_material(std::uint32_t seed) {
         default: break;
         }
     }
-    alignas(64) float packed[12][kBlockLanes];
-    for (int k = 0; k < 12; ++k)
+    alignas(64) float packed[18][kBlockLanes];
+    for (int k = 0; k < 18; ++k)
         for (int l = 0; l < N; ++l) packed[k][l] = var[k][pk.lane[l]];
     SurfaceLanes s;
     s.Px = packed[0]; s.Py = packed[1]; s.Pz = packed[2];
@@ -211,8 +247,14 @@ void check_material(std::uint32_t seed) {
         const int l = 4 * q;
         s.dudx[q] = var[6][l + 1] - var[6][l]; s.dvdx[q] = var[7][l + 1] - var[7][l];
         s.dudy[q] = var[6][l + 2] - var[6][l]; s.dvdy[q] = var[7][l + 2] - var[7][l];
+        s.dudx_more[0][q] = var[12][l + 1] - var[12][l]; s.dvdx_more[0][q] = var[13][l + 1] - var[13][l];
+        s.dudy_more[0][q] = var[12][l + 2] - var[12][l]; s.dvdy_more[0][q] = var[13][l + 2] - var[13][l];
     }
     s.back_facing = front ? 0u : 0xFFFFu;
+    if (extended) {
+        s.u_more[0] = packed[12]; s.v_more[0] = packed[13];
+        s.Cr = packed[14]; s.Cg = packed[15]; s.Cb = packed[16]; s.Ca = packed[17];
+    }
 
     MaterialBlock mb;
     const std::uint32_t kill = sample_material_lanes<N>(bm, s, pk.live, mb);
@@ -227,6 +269,13 @@ void check_material(std::uint32_t seed) {
         sp.duv_dx = {var[6][q + 1] - var[6][q], var[7][q + 1] - var[7][q]};
         sp.duv_dy = {var[6][q + 2] - var[6][q], var[7][q + 2] - var[7][q]};
         sp.front_facing = front;
+        if (extended) {
+            sp.uv_more[0] = {var[12][bl], var[13][bl]};
+            sp.duv_more_dx[0] = {var[12][q + 1] - var[12][q], var[13][q + 1] - var[13][q]};
+            sp.duv_more_dy[0] = {var[12][q + 2] - var[12][q], var[13][q + 2] - var[13][q]};
+            sp.has_color = true;
+            sp.color = {var[14][bl], var[15][bl], var[16][bl], var[17][bl]};
+        }
         const MaterialSample ms = sample_material(bm, sp);
         INFO("seed ", seed, " N ", N, " lane ", l, " (block lane ", bl, ")");
         const bool killed = m.alpha_mode == AlphaMode::Mask && !(ms.alpha >= m.alpha_cutoff);
@@ -245,6 +294,7 @@ void check_material(std::uint32_t seed) {
         CHECK(bits(mb.Nz[l]) == bits(ms.N.z));
         CHECK(bits(mb.Px[l]) == bits(sp.P.x));
         CHECK(bits(mb.ior) == bits(ms.ior));
+        if (m.alpha_mode != AlphaMode::Opaque) CHECK(bits(mb.alpha[l]) == bits(ms.alpha));
     }
 }
 
@@ -448,6 +498,35 @@ TEST_CASE("block trilinear sampling equals Texture::sample_trilinear bit for bit
         check_sampler<16>(seed);
         check_sampler<8>(seed);
         check_sampler<4>(seed);
+    }
+}
+
+TEST_CASE("block sampling with glTF filters equals Texture::sample_lod bit for bit") {
+    for (std::uint32_t seed = 1; seed <= 3000; ++seed) {
+        check_sampler<16>(seed, true);
+        check_sampler<8>(seed, true);
+        check_sampler<4>(seed, true);
+    }
+    // Every (wrap s, wrap t, mag, min) combination, each on many blocks.
+    const Wrap wraps[3] = {Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat};
+    std::uint32_t seed = 100000;
+    for (Wrap s : wraps)
+        for (Wrap t : wraps)
+            for (Filter mag : kFilters)
+                for (MinFilter min : kMinFilters) {
+                    const SamplerState st{s, t, mag, min};
+                    for (int i = 0; i < 40; ++i, ++seed) {
+                        check_sampler<16>(seed, true, &st);
+                        check_sampler<4>(seed, true, &st);
+                    }
+                }
+}
+
+TEST_CASE("material lanes with samplers, UV set 1 and vertex colours equal sample_material bit for bit") {
+    for (std::uint32_t seed = 1; seed <= 1500; ++seed) {
+        check_material<16>(seed, true);
+        check_material<8>(seed, true);
+        check_material<4>(seed, true);
     }
 }
 

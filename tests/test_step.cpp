@@ -1,4 +1,4 @@
-// The `step` executable end to end (issue 10), through the built binary:
+// The `step` executable end to end, through the built binary:
 // every explained pixel equals render's output (the 8-bit PNG exactly, the
 // linear colour as render's .hdr stores it) over grids of pixels on the
 // built-in scene, the tea set and NormalTangentTest; `verify` finds every
@@ -401,7 +401,7 @@ TEST_CASE("flags: step takes every flag of render's --help, or refuses it") {
     // debug view; --samples belongs to --ibl reference, which step refuses;
     // step never reads outside the model's folder (it may serve what it reads).
     const std::vector<std::string> refused = {"--output", "--frames", "--orbit", "--frame-range", "--repeat",
-                                              "--view", "--stats", "--allow-outside-paths"};
+                                              "--view", "--stats", "--allow-outside-paths", "--fps", "--list"};
     for (const std::string& f : flags(render_help.out)) {
         INFO("render flag " << f);
         if (std::find(listed.begin(), listed.end(), f) != listed.end() || f == "--samples") continue;

@@ -33,8 +33,9 @@ std::string wrapped_view_names(std::size_t width) {
 } // namespace
 
 const std::vector<std::string>& render_only_flags() {
-    static const std::vector<std::string> flags = {"-o",      "--output", "--frames", "--orbit", "--frame-range",
-                                                   "--repeat", "--view",  "--stats",  "--allow-outside-paths"};
+    static const std::vector<std::string> flags = {"-o",       "--output", "--frames", "--orbit",
+                                                   "--frame-range", "--repeat", "--view", "--stats",
+                                                   "--allow-outside-paths", "--fps", "--list"};
     return flags;
 }
 
@@ -351,6 +352,52 @@ void add_render_flags(FlagSet& set, RenderParse& st, bool render_only) {
         ti.help = "Tile size in pixels, a power of two from 16 to 256. The image does not depend on it.";
         ti.hints = {"tile-size", "tiles", "bin-size"};
     }
+    {
+        Flag& t = set.value({"--time"}, "SEC", "animation time in seconds", "0", {"nan", "x", "1e10"},
+                            [&o](const std::string& flag, const std::string& v) {
+                                double d;
+                                if (!parse_finite(v, d) || std::fabs(d) > kMaxAnimationTime)
+                                    bad_value(flag, v, "not a finite number of seconds (at most 1e9)");
+                                o.time = d;
+                            });
+        t.help = "The time, in seconds, at which the model's animations are sampled (frame 0 of a sequence). "
+                 "Before an animation's first key it holds its first value, after the last its last. Skins and "
+                 "morph targets are applied at any time.";
+        t.hints = {"t", "seconds", "at", "keyframe", "anim-time"};
+        Flag& a = set.value({"--animation"}, "NAME|INDEX", "which animation plays", "all", {""},
+                            [&o](const std::string& flag, const std::string& v) {
+                                if (v.empty()) bad_value(flag, v, "expected an animation's name or index");
+                                o.animation = v;
+                            });
+        a.help = "The animation to play, by name or index (`render --list` shows them). Default: every animation "
+                 "at once, a later one winning where two move the same node.";
+        a.hints = {"anim", "clip", "take", "action"};
+        Flag& c = set.value({"--camera"}, "NAME|INDEX", "a camera of the file", "framed on the scene", {""},
+                            [&o](const std::string& flag, const std::string& v) {
+                                if (v.empty()) bad_value(flag, v, "expected a camera's name or index");
+                                o.camera = v;
+                            });
+        c.help = "Looks through a camera of the model, by name or index (`render --list` shows them), with its "
+                 "node's transform and animation; perspective or orthographic. The image's aspect (`--size`) is "
+                 "used, not the file's aspectRatio. `--near`/`--far` override its planes.";
+        c.hints = {"cam", "view-camera", "file-camera", "viewpoint"};
+    }
+    if (wanted("--fps")) {
+        Flag& f = set.value({"--fps"}, "F", "frames a second of a sequence", "", {"0", "-1", "nan", "2e6"},
+                            [&o](const std::string& flag, const std::string& v) {
+                                double d;
+                                if (!parse_finite(v, d) || !(d > 0.0) || d > 1e6)
+                                    bad_value(flag, v, "must be a positive number of frames a second (at most 1e6)");
+                                o.fps = d;
+                            });
+        f.help = "With `--frames N`: renders a sequence through the animation instead of a turntable, frame i at "
+                 "`--time` + i / F seconds. Needs `--frames`.";
+        f.hints = {"framerate", "frame-rate", "rate", "sequence"};
+        Flag& l = set.toggle({"--list"}, "print the model's contents", [&o] { o.list = true; });
+        l.help = "Prints the model's meshes, materials, cameras, animations (name, duration, channels), skins and "
+                 "the extensions it uses and requires, then exits without rendering.";
+        l.hints = {"info", "inspect", "contents", "describe", "ls"};
+    }
     if (wanted("--frames")) {
         Flag& f = set.value({"--frames"}, "N", "turntable images", "1", {"0", "x"},
                             [&st, integer](const std::string& flag, const std::string& v) {
@@ -360,8 +407,8 @@ void add_render_flags(FlagSet& set, RenderParse& st, bool render_only) {
                                 st.out.frames = int(n);
                                 st.frames_given = true;
                             });
-        f.help = "A turntable of N images orbiting the target around `--up`; the file name needs a frame number "
-                 "(`-o frame%04d.png`).";
+        f.help = "A turntable of N images orbiting the target around `--up`, or with `--fps` a sequence through "
+                 "the animation; the file name needs a frame number (`-o frame%04d.png`).";
         f.hints = {"turntable", "animation", "count", "nframes"};
         Flag& ob = set.value({"--orbit"}, "DEG", "turntable angle in total", "360", {"nan"},
                              [&o](const std::string& flag, const std::string& v) {
@@ -451,6 +498,18 @@ std::string finish_render_options(RenderParse& st, const std::vector<std::string
     if (out.samples_given && out.ibl != IblMode::Reference && !out.pixel)
         return "--samples: only used with --ibl reference (or --pixel)";
     if (out.orbit_given && !st.frames_given) return "--orbit: needs --frames N (the number of turntable images)";
+    if (out.fps > 0.0 && !st.frames_given) return "--fps: needs --frames N (the number of images of the sequence)";
+    if (out.list && out.scene.empty()) return "--list: needs a MODEL (a .gltf, .glb or .obj file)";
+    if (!out.camera.empty()) {
+        for (const auto& [given, name] : {std::pair<bool, const char*>{out.eye.has_value(), "--eye"},
+                                          {out.target.has_value(), "--target"},
+                                          {out.up.has_value(), "--up"},
+                                          {out.fov_deg != 45.0f, "--fov"}})
+            if (given) return std::string("--camera: the file's camera places the view; it cannot be combined with ") + name;
+        if (out.scene.empty()) return "--camera: the built-in scene has no cameras; give a MODEL";
+        if (out.frames > 1 && out.fps == 0.0)
+            return "--camera: a file's camera does not orbit; give --fps F for a sequence through time";
+    }
     render_cli::FramePattern pattern(out.output);
     if (out.frames > 1 && !pattern.has_number)
         return "-o '" + out.output + "': a turntable of " + std::to_string(out.frames) +
@@ -472,10 +531,9 @@ std::vector<HelpRow> render_help_rows(bool render_only) {
     rows.push_back({{"--size"}, ""});
     rows.push_back({{"--eye", "--target", "--up"}, "camera (default: framed on the scene)"});
     rows.push_back({{"--fov", "--near", "--far"}, "field of view (default 45), clip planes (fitted)"});
-    rows.push_back({{"--sun"}, ""});
-    rows.push_back({{"--point"}, ""});
-    rows.push_back({{"--ambient"}, ""});
-    rows.push_back({{"--no-default-lights"}, ""});
+    rows.push_back({{"--sun", "--point"}, "lights (repeatable)"});
+    rows.push_back({{"--ambient", "--no-default-lights"}, "(default 0.03); no key+fill rig"});
+    rows.push_back({{"--time", "--animation", "--camera"}, render_only ? "time 0, all animations" : "time, animation, camera"});
     rows.push_back({{"--env", "--env-intensity", "--env-rotate"}, "image-based lighting"});
     rows.push_back({{"--background", "--ibl", "--samples"}, ""});
     rows.push_back({{"--brdf", "--energy", "--msaa"}, "(1, 2, 4, 8; default 4)"});
@@ -484,12 +542,12 @@ std::vector<HelpRow> render_help_rows(bool render_only) {
     rows.push_back({{"--shadows", "--shadow-size"}, "shadow maps (default off, 2048 texels)"});
     rows.push_back({{"--threads", "--tile"}, "default: all cores; tile 16..256 (default 64)"});
     if (render_only) {
-        rows.push_back({{"--frames", "--orbit"},
-                        "turntable: N images orbiting the target around --up,\n"
-                        "DEG in total (default 360); FILE needs %04d"});
+        rows.push_back({{"--frames", "--orbit", "--fps"},
+                        "turntable around --up, DEG (default 360);\n"
+                        "--fps: frames in time; FILE needs %04d"});
         rows.push_back({{"--frame-range", "--repeat"}, "frames A..B only; N times, print frame_ms"});
         rows.push_back({{"--stats", "--pixel"}, "per-stage counters and times; probe a pixel"});
-        rows.push_back({{"--allow-outside-paths"}, ""});
+        rows.push_back({{"--allow-outside-paths", "--list"}, "files outside the model's folder; list it"});
     } else {
         rows.push_back({{"--pixel"}, "explain one pixel and exit"});
     }

@@ -111,7 +111,8 @@ std::string step_markdown() {
                           "Records one frame, as `render` with the same flags would draw it, and explains it: "
                           "commands on standard input, `--out DIR`, `--serve` or `--pixel X,Y`. The scene, camera, "
                           "light and view flags are render's (see there); render's `-o`, `--frames`, `--orbit`, "
-                          "`--frame-range`, `--repeat`, `--view`, `--stats` and `--allow-outside-paths` are refused. "
+                          "`--fps`, `--frame-range`, `--repeat`, `--view`, `--stats`, `--list` and "
+                          "`--allow-outside-paths` are refused. "
                           "Exit codes: 0 ok, 1 a bad file or a failed command, 2 bad usage.",
                           [](const Flag& f) {
                               for (const char* own : {"--out", "--serve", "--port", "--pixel", "--help", "--version"})

@@ -239,7 +239,9 @@ void ShadowMaps::draw_casters(const Scene& scene, const std::vector<BoundMateria
     st.cull = CullMode::None;
     for (std::size_t mi = 0; mi < scene.meshes.size(); ++mi) {
         const Mesh& mesh = scene.meshes[mi];
-        if (mesh.indices.empty() || mesh_bounds_[mi].empty() || box_outside(mesh_bounds_[mi], origin, view_proj))
+        // Lines and points are 1 pixel wide in the image: they cast no shadow.
+        if (mesh.topology != Mesh::Topology::Triangles || mesh.indices.empty() || mesh_bounds_[mi].empty() ||
+            box_outside(mesh_bounds_[mi], origin, view_proj))
             continue;
         const BoundMaterial* bm = mesh.material >= 0 && std::size_t(mesh.material) < materials.size()
                                       ? &materials[std::size_t(mesh.material)] : &kFallbackBound;

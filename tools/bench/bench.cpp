@@ -1,5 +1,5 @@
-// bench: frame times of the full PBR pipeline on the speed workloads of issue
-// 8, for speed work and the issue notes. Timing belongs here, never in unit
+// bench: frame times of the full PBR pipeline on the speed workloads
+// (docs/performance.md), for speed work. Timing belongs here, never in unit
 // tests.
 //
 //   bench [--workload quad,grid,bottle,tea,bunny,builtin] [--threads 1,2] [--repeat N] [--json]
