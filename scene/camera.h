@@ -1,4 +1,4 @@
-// A perspective camera (conventions.md: right-handed, +Y up, looking down -Z in
+// A perspective camera (docs/conventions.md: right-handed, +Y up, looking down -Z in
 // view space, OpenGL clip space) and its default framing on a scene's bounds.
 #pragma once
 

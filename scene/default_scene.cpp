@@ -37,7 +37,7 @@ Image make_default_sky(int width) {
     const float texel = 3.14159265f / float(img.height);
     for (int y = 0; y < img.height; ++y)
         for (int x = 0; x < img.width; ++x) {
-            // The direction of the texel centre (conventions.md "Environment maps").
+            // The direction of the texel centre (docs/conventions.md "Environment maps").
             const float phi = ((float(x) + 0.5f) / float(img.width) - 0.5f) * 6.28318531f;
             const float theta = (float(y) + 0.5f) / float(img.height) * 3.14159265f;
             const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));

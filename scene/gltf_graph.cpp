@@ -152,16 +152,16 @@ private:
         if (a.count > kMaxCount) fail(what + ": absurd count " + std::to_string(a.count));
         if (a.bufferView < 0) {
             ctx_.zero_filled += a.count;
-            if (ctx_.zero_filled > detail::kMaxZeroFilledElements)
+            if (ctx_.zero_filled > scene_detail::kMaxZeroFilledElements)
                 fail(what + ": " + std::to_string(a.count) + " elements without a bufferView bring the zero-filled "
                      "elements to " + std::to_string(ctx_.zero_filled) + ", more than the limit of " +
-                     std::to_string(detail::kMaxZeroFilledElements) + " (2^22)");
+                     std::to_string(scene_detail::kMaxZeroFilledElements) + " (2^22)");
         }
         ctx_.elements += a.count;
-        if (ctx_.elements > detail::kMaxSceneElements)
+        if (ctx_.elements > scene_detail::kMaxSceneElements)
             fail(what + ": " + std::to_string(a.count) + " elements bring the scene to " +
                  std::to_string(ctx_.elements) + " accessor elements, more than the limit of " +
-                 std::to_string(detail::kMaxSceneElements) + " (2^27)");
+                 std::to_string(scene_detail::kMaxSceneElements) + " (2^27)");
         const std::size_t elem = csize * std::size_t(ncomp);
         const bool normalized = a.normalized && !integers;
         std::vector<T> out;

@@ -1,6 +1,6 @@
 // Decoded images, in their own format: 8-bit texels with the file's channel
 // count (grey, grey+alpha, RGB, RGBA), colour channels still sRGB-encoded when
-// the image is a colour map (base colour, emissive; conventions.md
+// the image is a colour map (base colour, emissive; docs/conventions.md
 // "Textures"), or linear float RGBA for HDR files, 16-bit files and the
 // procedural images of the built-in scene. Decoding PNG, JPEG and Radiance HDR
 // files (or embedded bytes). Row 0 is the top row of the image as shown (a

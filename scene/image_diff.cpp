@@ -46,7 +46,7 @@ Image8 read_image8(const std::string& path) {
     // stranger is as safe to compare as to render.
     ImageSource src;
     src.name = path;
-    src.bytes = detail::read_file(path);
+    src.bytes = scene_detail::read_file(path);
     if (src.bytes.empty()) throw LoadError(path + ": empty file");
     if (looks_like_hdr(src.bytes.data(), src.bytes.size()))
         throw LoadError(path + ": is a Radiance HDR image; only 8-bit images (PNG, ...) can be compared");

@@ -1,5 +1,5 @@
 // Reading an environment map (render --env): an equirectangular Radiance
-// .hdr (conventions.md "Environment maps"), decoded by decode_image() to
+// .hdr (docs/conventions.md "Environment maps"), decoded by decode_image() to
 // linear float RGBA as stored (the map's own exposure). Anything that is not a
 // Radiance file, or that fails to decode, is a LoadError "FILE: problem".
 #pragma once

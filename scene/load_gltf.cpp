@@ -110,7 +110,7 @@ bool scoped_read_file(std::vector<unsigned char>* out, std::string* err, const s
         return false;
     }
     try {
-        *out = read_regular_file(it->second, detail::kMaxFileBytes);
+        *out = read_regular_file(it->second, scene_detail::kMaxFileBytes);
         std::string why;
         if (!fs_state.scope->charge(out->size(), why)) {
             out->clear();
@@ -360,7 +360,7 @@ bool finite_values(const std::vector<double>& v) {
 // at most a 2048 x 2048 texture's worth each.
 constexpr std::int64_t kMaxBakeTexels = std::int64_t(1) << 22;
 
-// A metal-rough material (prast's BRDF, conventions.md "Shading": F0 =
+// A metal-rough material (prast's BRDF, docs/conventions.md "Shading": F0 =
 // mix(f0(ior), albedo, metallic), diffuse = (1 - F) (1 - metallic) albedo,
 // alpha = roughness^2) for specular-glossiness values (the extension: F0 =
 // specular, diffuse = (1 - F) c_diff with c_diff = diffuse (1 - max(specular)),
@@ -440,7 +440,7 @@ public:
         GltfGraphContext graph{shown_, elements_, zero_filled_, [this](const std::string& w) { warn(w); }};
         read_gltf_graph(model_, scene_, graph);  // skins, morph targets, animations, cameras
         scene_.warnings = log_.lines();
-        detail::finish_scene(scene_, path_);
+        scene_detail::finish_scene(scene_, path_);
         pose_scene(scene_, 0.0, kNoAnimation);  // the rest pose: skins and default morph weights applied
         return std::move(scene_);
     }
@@ -468,9 +468,9 @@ private:
     // ---- Parsing (tinygltf)
 
     void parse() {
-        std::vector<unsigned char> bytes = detail::read_file(path_);
+        std::vector<unsigned char> bytes = scene_detail::read_file(path_);
         const bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-        if (!glb && detail::extension_lower(path_) == ".glb")
+        if (!glb && scene_detail::extension_lower(path_) == ".glb")
             fail("not a binary glTF (bad magic)");
 
         tinygltf::TinyGLTF ctx;
@@ -592,10 +592,10 @@ private:
         // Budgets first, before anything is allocated or looped over.
         if (a.bufferView < 0) {
             zero_filled_ += a.count;
-            if (zero_filled_ > detail::kMaxZeroFilledElements)
+            if (zero_filled_ > scene_detail::kMaxZeroFilledElements)
                 fail(what + ": " + std::to_string(a.count) + " elements without a bufferView bring the zero-filled "
                      "elements to " + std::to_string(zero_filled_) + ", more than the limit of " +
-                     std::to_string(detail::kMaxZeroFilledElements) + " (2^22)");
+                     std::to_string(scene_detail::kMaxZeroFilledElements) + " (2^22)");
         }
         charge(a.count, what);
         const std::size_t elem = csize * std::size_t(ncomp);
@@ -741,7 +741,7 @@ private:
             out.resize(got);
             return out;
         };
-        if (size > detail::kMaxFileBytes) return;
+        if (size > scene_detail::kMaxFileBytes) return;
         // Of a .glb only its JSON chunk (checked when the model was parsed).
         std::string text = read_at(0, std::size_t(std::min<std::uint64_t>(size, 20)));
         if (text.size() == 20 && text.compare(0, 4, "glTF") == 0)
@@ -1465,9 +1465,9 @@ private:
     // checked before each accessor is allocated.
     void charge(std::size_t elements, const std::string& what) {
         elements_ += elements;
-        if (elements_ > detail::kMaxSceneElements)
+        if (elements_ > scene_detail::kMaxSceneElements)
             fail(what + ": " + std::to_string(elements) + " elements bring the scene to " + std::to_string(elements_) +
-                 " accessor elements, more than the limit of " + std::to_string(detail::kMaxSceneElements) +
+                 " accessor elements, more than the limit of " + std::to_string(scene_detail::kMaxSceneElements) +
                  " (2^27)");
     }
 

@@ -1,5 +1,5 @@
 // Wavefront OBJ + MTL through tinyobjloader, into world-space meshes and
-// metal-roughness materials (conventions.md, "Materials from OBJ + MTL").
+// metal-roughness materials (docs/conventions.md, "Materials from OBJ + MTL").
 //
 // tinyobjloader gives absent MTL keys a value (Kd 0, or 0.6 once some map_Kd
 // was seen in the file, Pr 0, Pm 0), so "absent" cannot be told from "0". We
@@ -108,7 +108,7 @@ public:
         if (!loaded_.insert(where.path).second) return true;
         std::vector<unsigned char> bytes;
         try {
-            bytes = read_regular_file(where.path, detail::kMaxFileBytes, mat_id);
+            bytes = read_regular_file(where.path, scene_detail::kMaxFileBytes, mat_id);
             std::string why;
             if (!scope_.charge(bytes.size(), why)) throw LoadError(printable(cut(mat_id)) + ": " + why);
         } catch (const LoadError& e) {
@@ -212,7 +212,7 @@ public:
         : path_(path), shown_(printable(path)), scope_(path, options.allow_outside_paths) {}
 
     Scene load() {
-        const std::vector<unsigned char> bytes = detail::read_file(path_);
+        const std::vector<unsigned char> bytes = scene_detail::read_file(path_);
         const std::string text(bytes.begin(), bytes.end());
         prevalidate(text, path_);
 
@@ -239,7 +239,7 @@ public:
             throw LoadError(shown_ + ": face index out of range");
         pass_on_warnings(warn);
         scene_.warnings = log_.lines();
-        detail::finish_scene(scene_, path_);
+        scene_detail::finish_scene(scene_, path_);
         return std::move(scene_);
     }
 
@@ -346,7 +346,7 @@ private:
                          "' ignored");
         }
         // Dissolve (`d`, or 1 - `Tr` as tinyobjloader reads it): glTF's BLEND
-        // with the base colour's alpha (README "Transparency").
+        // with the base colour's alpha (docs/shadows-and-transparency.md).
         const double dissolve = src.dissolve;
         if (std::isfinite(dissolve) && dissolve < 1.0) {
             m.alpha_mode = AlphaMode::Blend;
@@ -400,9 +400,9 @@ private:
             }
             total += idx.size();
         }
-        if (total > detail::kMaxSceneElements)
+        if (total > scene_detail::kMaxSceneElements)
             throw LoadError(shown_ + ": too many triangles (" + std::to_string(total / 3) + " corners; at most " +
-                            std::to_string(detail::kMaxSceneElements) + ")");
+                            std::to_string(scene_detail::kMaxSceneElements) + ")");
         const std::vector<glm::vec3> smooth =
             need_normals ? position_normals(attrib, shapes) : std::vector<glm::vec3>();
 

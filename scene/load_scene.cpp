@@ -22,14 +22,14 @@ namespace fs = std::filesystem;
 Scene load_scene(const std::string& path, const LoadOptions& options) {
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw LoadError(printable(path) + ": is a directory, not a file");
-    const std::string ext = detail::extension_lower(path);
+    const std::string ext = scene_detail::extension_lower(path);
     if (ext == ".obj") return load_obj(path, options);
     if (ext == ".gltf" || ext == ".glb") return load_gltf(path, options);
     throw LoadError(printable(path) + ": unknown extension '" + printable(fs::path(path).extension().string()) +
                     "' (expected .obj, .gltf or .glb)");
 }
 
-namespace detail {
+namespace scene_detail {
 
 std::string extension_lower(const std::string& path) {
     std::string ext = fs::path(path).extension().string();
@@ -264,6 +264,6 @@ void finish_scene(Scene& scene, const std::string& path_in) {
     if (scene.meshes.empty()) throw LoadError(path + ": no triangles");
 }
 
-} // namespace detail
+} // namespace scene_detail
 
 } // namespace prast

@@ -38,7 +38,7 @@ Scene load_obj(const std::string& path, const LoadOptions& options = {});
 // is flattened into world-space meshes; KHR_lights_punctual gives the lights.
 Scene load_gltf(const std::string& path, const LoadOptions& options = {});
 
-namespace detail {
+namespace scene_detail {
 
 // Limits that keep a hostile file from exhausting memory; each is far beyond
 // the assets the project renders (the largest has 70 k triangles) and the
@@ -67,6 +67,6 @@ std::string extension_lower(const std::string& path);
 // valid. Throws LoadError "PATH: no triangles" when nothing is left.
 void finish_scene(Scene& scene, const std::string& path);
 
-} // namespace detail
+} // namespace scene_detail
 
 } // namespace prast

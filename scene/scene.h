@@ -5,7 +5,7 @@
 // UV convention inside the project: glTF's, v = 0 is the TOP row of an image.
 // The OBJ loader converts (v_internal = 1 - v_obj), so samplers and tangent
 // generation follow one rule: T runs along +u, and the normal-map bitangent
-// B = cross(N, T) * w points towards -v (up the image), see conventions.md.
+// B = cross(N, T) * w points towards -v (up the image), see docs/conventions.md.
 #pragma once
 
 #include <cstdint>

@@ -2,7 +2,7 @@
 // area-weighted normals, and tangents (xyz + handedness w) from UV derivatives
 // in the project's internal UV convention (v = 0 is the top row of an image).
 //
-// The frame follows conventions.md, "Normal mapping": T runs along +u and the
+// The frame follows docs/conventions.md, "Normal mapping": T runs along +u and the
 // bitangent B = cross(N, T) * w points "up the image", which is -v here, so the
 // handedness is measured against B = -dP/dv (the assets README: "a renderer that
 // builds tangents from raw glTF UVs must use B = -dP/dv_glTF").
