@@ -175,7 +175,7 @@ std::string check_output_path(const std::string& path) {
 
 // "" when every frame of [first, last] can be written: each distinct
 // directory is probed once, before the first frame is rendered.
-std::string check_output_paths(const render_cli::FramePattern& pattern, int first, int last) {
+std::string check_output_paths(const cli::FramePattern& pattern, int first, int last) {
     std::set<std::string> dirs;
     std::error_code ec;
     for (int frame = first; frame <= last; ++frame) {
@@ -431,7 +431,7 @@ int run(int argc, char** argv) {
     if (opt.list) return list_model(opt);
     // Fail on an unwritable output before spending time on the render: every
     // frame's directory, so a turntable cannot fail half-way.
-    const render_cli::FramePattern pattern(opt.output);
+    const cli::FramePattern pattern(opt.output);
     const std::string out_err = check_output_paths(pattern, opt.first_frame, opt.last_frame);
     if (!out_err.empty()) {
         std::fprintf(stderr, "render: %s\n", printable(out_err).c_str());

@@ -119,15 +119,7 @@ struct RenderOptions {
 // The --help text, made from the flag definitions: fits an 80x24 terminal.
 const char* render_usage();
 
-namespace render_cli {
-
-using cli::ends_with;
-using cli::lower;
-using cli::non_negative;
-using cli::parse_finite;
-using cli::parse_integer;
-using cli::parse_vec3;
-using cli::split;
+namespace cli {
 
 // The output name's frame-number pattern: one %d, %4d or %04d (any width up
 // to 9), with %% for a literal percent. Formatted here rather than by printf
@@ -179,9 +171,9 @@ private:
     std::size_t begin_ = 0, end_ = 0;
 };
 
-} // namespace render_cli
+} // namespace cli
 
-inline bool RenderOptions::hdr_output() const { return render_cli::ends_with(render_cli::lower(output), ".hdr"); }
+inline bool RenderOptions::hdr_output() const { return cli::ends_with(cli::lower(output), ".hdr"); }
 
 // "" when a w x h image fits; otherwise the reason, with the bytes it needs.
 inline std::string check_image_size(long w, long h, std::uint64_t budget_bytes) {

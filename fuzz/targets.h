@@ -145,7 +145,7 @@ inline bool run_cli(const std::uint8_t* data, std::size_t size) {
     if (!within(o.eye) || !within(o.target)) return false;
     if (!std::isfinite(o.exposure) || !(o.exposure > 0.0f) || !std::isfinite(o.orbit_deg)) return false;
     if (o.near_plane && o.far_plane && !(*o.near_plane < *o.far_plane)) return false;
-    const render_cli::FramePattern pattern(o.output);
+    const cli::FramePattern pattern(o.output);
     if (!pattern.error.empty() || (o.frames > 1 && !pattern.has_number)) return false;
     if (pattern.format(o.first_frame).empty() || pattern.format(o.last_frame).empty()) return false;
     if (o.pixel && (o.pixel->x >= o.width || o.pixel->y >= o.height)) return false;

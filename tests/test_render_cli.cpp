@@ -207,18 +207,18 @@ TEST_CASE("parser: --size refuses what does not fit the memory budget, with the 
 }
 
 TEST_CASE("parser: frame-number patterns") {
-    render_cli::FramePattern p("out/f%04d.png");
+    cli::FramePattern p("out/f%04d.png");
     CHECK(p.has_number);
     CHECK(p.format(7) == "out/f0007.png");
     CHECK(p.format(12345) == "out/f12345.png");
-    CHECK(render_cli::FramePattern("f%d.png").format(42) == "f42.png");
-    CHECK(render_cli::FramePattern("f%3d.png").format(5) == "f  5.png");
-    CHECK(render_cli::FramePattern("100%%_%02d.png").format(3) == "100%_03.png");
-    render_cli::FramePattern plain("render.png");
+    CHECK(cli::FramePattern("f%d.png").format(42) == "f42.png");
+    CHECK(cli::FramePattern("f%3d.png").format(5) == "f  5.png");
+    CHECK(cli::FramePattern("100%%_%02d.png").format(3) == "100%_03.png");
+    cli::FramePattern plain("render.png");
     CHECK(!plain.has_number);
     CHECK(plain.format(3) == "render.png");
-    CHECK(!render_cli::FramePattern("a%d%d.png").error.empty());
-    CHECK(!render_cli::FramePattern("a%n.png").error.empty());
+    CHECK(!cli::FramePattern("a%d%d.png").error.empty());
+    CHECK(!cli::FramePattern("a%n.png").error.empty());
 }
 
 // ---------------------------------------------------------------- end to end

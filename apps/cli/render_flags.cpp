@@ -74,7 +74,7 @@ void add_render_flags(FlagSet& set, RenderParse& st, bool render_only) {
                                 const std::string l = lower(v);
                                 if (!ends_with(l, ".png") && !ends_with(l, ".hdr"))
                                     bad_value(flag, v, "unknown output format (expected a .png or .hdr file name)");
-                                render_cli::FramePattern pattern(v);
+                                cli::FramePattern pattern(v);
                                 if (!pattern.error.empty()) bad_value(flag, v, pattern.error);
                                 o.output = v;
                             });
@@ -510,7 +510,7 @@ std::string finish_render_options(RenderParse& st, const std::vector<std::string
         if (out.frames > 1 && out.fps == 0.0)
             return "--camera: a file's camera does not orbit; give --fps F for a sequence through time";
     }
-    render_cli::FramePattern pattern(out.output);
+    cli::FramePattern pattern(out.output);
     if (out.frames > 1 && !pattern.has_number)
         return "-o '" + out.output + "': a turntable of " + std::to_string(out.frames) +
                " frames needs a frame number in the file name, e.g. frame%04d.png";
