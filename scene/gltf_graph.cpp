@@ -15,6 +15,7 @@
 #include <tiny_gltf.h>
 
 #include "scene/animation.h"
+#include "scene/gltf_components.h"
 #include "scene/load_scene.h"
 #include "scene/messages.h"
 
@@ -22,19 +23,10 @@ namespace prast {
 
 namespace {
 
-constexpr std::size_t kMaxCount = 0x7fffffff;
+using gltf_components_detail::component;
+using gltf_components_detail::component_size;
 
-std::size_t component_bytes(int type) {
-    switch (type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
-    }
-}
+constexpr std::size_t kMaxCount = 0x7fffffff;
 
 int components_of(int type) {
     switch (type) {
@@ -44,39 +36,6 @@ int components_of(int type) {
     case TINYGLTF_TYPE_VEC4: return 4;
     case TINYGLTF_TYPE_MAT4: return 16;
     default: return 0;
-    }
-}
-
-// One component; normalized integers mapped as glTF 2.0 "Animations" and
-// "Meshes" say (c / 127 clamped at -1, c / 255, ...).
-double read_component(const unsigned char* p, int type, bool normalized) {
-    switch (type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        std::int8_t v;
-        std::memcpy(&v, p, 1);
-        return normalized ? std::max(v / 127.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        std::int16_t v;
-        std::memcpy(&v, p, 2);
-        return normalized ? std::max(v / 32767.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        std::uint16_t v;
-        std::memcpy(&v, p, 2);
-        return normalized ? v / 65535.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        std::uint32_t v;
-        std::memcpy(&v, p, 4);
-        return normalized ? v / 4294967295.0 : v;
-    }
-    default: {
-        float v;
-        std::memcpy(&v, p, 4);
-        return v;
-    }
     }
 }
 
@@ -144,7 +103,7 @@ private:
             fail(what + " out of range (" + std::to_string(model_.accessors.size()) + " accessors)");
         const tinygltf::Accessor& a = model_.accessors[std::size_t(index)];
         const int ncomp = components_of(a.type);
-        const std::size_t csize = component_bytes(a.componentType);
+        const std::size_t csize = component_size(a.componentType);
         if (a.type != type || ncomp == 0) fail(what + ": wrong type");
         if (csize == 0) fail(what + ": unsupported componentType " + std::to_string(a.componentType));
         if (integers && (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || a.normalized))
@@ -172,14 +131,14 @@ private:
             for (std::size_t i = 0; i < a.count; ++i)
                 for (int c = 0; c < ncomp; ++c)
                     out[i * std::size_t(ncomp) + std::size_t(c)] =
-                        T(read_component(p + i * stride + std::size_t(c) * csize, a.componentType, normalized));
+                        T(component(p + i * stride + std::size_t(c) * csize, a.componentType, normalized));
         } else {
             out.assign(a.count * std::size_t(ncomp), T(0));
         }
         if (a.sparse.isSparse) {
             const auto& s = a.sparse;
             if (s.count < 0 || std::size_t(s.count) > a.count) fail(what + ": bad sparse count");
-            const std::size_t isize = component_bytes(s.indices.componentType);
+            const std::size_t isize = component_size(s.indices.componentType);
             if (s.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
                 s.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
                 s.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || isize == 0)
@@ -192,11 +151,11 @@ private:
             const unsigned char* vp = window(s.values.bufferView, std::size_t(s.values.byteOffset), n, elem, false,
                                              vstride, what + " sparse values");
             for (std::size_t j = 0; j < n; ++j) {
-                const double target = read_component(ip + j * istride, s.indices.componentType, false);
+                const double target = component(ip + j * istride, s.indices.componentType, false);
                 if (target >= double(a.count)) fail(what + ": sparse index out of range");
                 for (int c = 0; c < ncomp; ++c)
                     out[std::size_t(target) * std::size_t(ncomp) + std::size_t(c)] =
-                        T(read_component(vp + j * vstride + std::size_t(c) * csize, a.componentType, normalized));
+                        T(component(vp + j * vstride + std::size_t(c) * csize, a.componentType, normalized));
             }
         }
         return out;

@@ -43,6 +43,7 @@
 #include <tiny_gltf.h>
 
 #include "scene/animation.h"
+#include "scene/gltf_components.h"
 #include "scene/file_access.h"
 #include "scene/image.h"
 #include "scene/gltf_graph.h"
@@ -53,6 +54,9 @@ namespace prast {
 namespace fs = std::filesystem;
 
 namespace {
+
+using gltf_components_detail::component;
+using gltf_components_detail::component_size;
 
 // Deeper JSON is refused before parsing: nlohmann::json and tinygltf's
 // conversion of extensions both recurse once per level.
@@ -297,18 +301,6 @@ std::string decode_uri(const std::string& uri) {
     return out;
 }
 
-std::size_t component_size(int type) {
-    switch (type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0; // INT and DOUBLE are not glTF 2.0 component types
-    }
-}
-
 int type_components(int type) {
     switch (type) {
     case TINYGLTF_TYPE_SCALAR: return 1;
@@ -316,39 +308,6 @@ int type_components(int type) {
     case TINYGLTF_TYPE_VEC3: return 3;
     case TINYGLTF_TYPE_VEC4: return 4;
     default: return 0;
-    }
-}
-
-// One component, as stored or mapped to [0, 1] / [-1, 1] when normalized
-// (glTF 2.0, "Animation" / "Meshes": c / 127 clamped at -1, c / 255, ...).
-double component(const unsigned char* p, int type, bool normalized) {
-    switch (type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        std::int8_t v;
-        std::memcpy(&v, p, 1);
-        return normalized ? std::max(v / 127.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        std::int16_t v;
-        std::memcpy(&v, p, 2);
-        return normalized ? std::max(v / 32767.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        std::uint16_t v;
-        std::memcpy(&v, p, 2);
-        return normalized ? v / 65535.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        std::uint32_t v;
-        std::memcpy(&v, p, 4);
-        return normalized ? v / 4294967295.0 : v;
-    }
-    default: {
-        float v;
-        std::memcpy(&v, p, 4);
-        return v;
-    }
     }
 }
 
