@@ -7,6 +7,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "scene/load_scene.h"
 #include "scene/tangents.h"
 
 namespace prast {
@@ -36,33 +37,6 @@ glm::dmat4 trs(const glm::dvec3& t, const glm::dquat& r, const glm::dvec3& s) {
 }
 
 bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-// The loader's tangent clean-up (orthogonalised against the normal,
-// normalised, w a sign); false when one is unusable.
-bool repair_tangents(Mesh& m) {
-    for (std::size_t i = 0; i < m.tangents.size(); ++i) {
-        glm::vec4& t = m.tangents[i];
-        const glm::dvec3 n(m.normals[i]);
-        glm::dvec3 xyz(t);
-        const double len0 = glm::length(xyz);
-        if (!(len0 > 0.0) || !std::isfinite(len0) || !std::isfinite(t.w)) return false;
-        xyz /= len0;
-        xyz -= n * glm::dot(n, xyz);
-        const double len = glm::length(xyz);
-        if (!(len > 1e-3)) return false;
-        t = glm::vec4(glm::vec3(xyz / len), t.w < 0.0f ? -1.0f : 1.0f);
-    }
-    return true;
-}
-
-// The UV set tangents follow: the normal map's (finish_scene's rule).
-const std::vector<glm::vec2>& tangent_uvs(const Mesh& m, const Scene& scene) {
-    if (m.material >= 0 && std::size_t(m.material) < scene.materials.size()) {
-        const TextureRef& normal = scene.materials[std::size_t(m.material)].normal;
-        if (normal.valid() && normal.texcoord == 1 && !m.uvs1.empty()) return m.uvs1;
-    }
-    return m.uvs;
-}
 
 } // namespace
 
@@ -273,9 +247,9 @@ void pose_scene(Scene& scene, double t, int animation) {
                 for (std::size_t j : bad_normals) mesh.normals[j] = computed[j];
             }
         }
-        const std::vector<glm::vec2>& tuv = tangent_uvs(mesh, scene);
+        const std::vector<glm::vec2>& tuv = scene_detail::tangent_uvs(mesh, scene);
         if (tuv.empty() || mesh.normals.empty()) mesh.tangents.clear();
-        else if (!file_tangents || mesh.tangents.size() != mesh.positions.size() || !repair_tangents(mesh))
+        else if (!file_tangents || mesh.tangents.size() != mesh.positions.size() || !scene_detail::repair_tangents(mesh))
             compute_tangents(mesh, tuv);
     }
     ++scene.pose_serial;

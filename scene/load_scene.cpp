@@ -130,18 +130,6 @@ std::size_t repair_colors(std::vector<glm::vec4>& colors) {
     return bad;
 }
 
-// The UV set that tangents follow: the one the material's normal map reads
-// (glTF 2.0, "Meshes": tangents from "the texture coordinates associated
-// with the normal texture"), TEXCOORD_0 when there is no normal map or the
-// mesh lacks the set it names.
-const std::vector<glm::vec2>& tangent_uvs(const Mesh& m, const Scene& scene) {
-    if (m.material >= 0 && std::size_t(m.material) < scene.materials.size()) {
-        const TextureRef& normal = scene.materials[std::size_t(m.material)].normal;
-        if (normal.valid() && normal.texcoord == 1 && !m.uvs1.empty()) return m.uvs1;
-    }
-    return m.uvs;
-}
-
 // Normalises the given normals; when any is unusable, the whole set is
 // replaced by computed ones for that vertex.
 std::size_t repair_normals(Mesh& m) {
@@ -166,6 +154,20 @@ std::size_t repair_normals(Mesh& m) {
     return bad.size();
 }
 
+} // namespace
+
+// The UV set that tangents follow: the one the material's normal map reads
+// (glTF 2.0, "Meshes": tangents from "the texture coordinates associated
+// with the normal texture"), TEXCOORD_0 when there is no normal map or the
+// mesh lacks the set it names.
+const std::vector<glm::vec2>& tangent_uvs(const Mesh& m, const Scene& scene) {
+    if (m.material >= 0 && std::size_t(m.material) < scene.materials.size()) {
+        const TextureRef& normal = scene.materials[std::size_t(m.material)].normal;
+        if (normal.valid() && normal.texcoord == 1 && !m.uvs1.empty()) return m.uvs1;
+    }
+    return m.uvs;
+}
+
 // File tangents: xyz orthogonalised against the (possibly repaired) normal and
 // normalised, w a sign. Returns false when any is unusable: non-finite, or
 // within 0.06 degrees of its normal, where rounding would leave the result
@@ -186,8 +188,6 @@ bool repair_tangents(Mesh& m) {
     }
     return true;
 }
-
-} // namespace
 
 void finish_scene(Scene& scene, const std::string& path_in) {
     const std::string path = printable(path_in);

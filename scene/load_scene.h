@@ -67,6 +67,13 @@ std::string extension_lower(const std::string& path);
 // valid. Throws LoadError "PATH: no triangles" when nothing is left.
 void finish_scene(Scene& scene, const std::string& path);
 
+// The UV set a mesh's tangents follow: its normal map's (TEXCOORD_1 when the
+// map names it and the mesh has it), else TEXCOORD_0.
+const std::vector<glm::vec2>& tangent_uvs(const Mesh& m, const Scene& scene);
+// File tangents orthogonalised against the normals and normalised, w a sign;
+// false when the sizes differ or any tangent is unusable.
+bool repair_tangents(Mesh& m);
+
 } // namespace scene_detail
 
 } // namespace prast
