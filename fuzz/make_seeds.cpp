@@ -323,6 +323,59 @@ void gltf_seeds() {
         R"("specularFactor":[0.2,0.2,0.2],"glossinessFactor":0.7}}},)"
         R"({"extensions":{"KHR_materials_pbrSpecularGlossiness":{"diffuseTexture":{"index":0},)"
         R"("specularGlossinessTexture":{"index":1},"specularFactor":[1,0.8,0.2]}}}]})");
+    // A skinned, morphed strip under an animated joint (LINEAR rotation,
+    // STEP translation, CUBICSPLINE weights) with a camera and a light on
+    // animated nodes.
+    std::string sb;
+    auto sf = [&](float v) { sb.append(reinterpret_cast<const char*>(&v), 4); };
+    auto su = [&](std::uint16_t v) { sb.append(reinterpret_cast<const char*>(&v), 2); };
+    for (float v : {-.5f, 0.f, 0.f, .5f, 0.f, 0.f, -.5f, 1.f, 0.f, .5f, 1.f, 0.f}) sf(v);        // 0: positions
+    for (int i = 0; i < 4; ++i) for (float v : {0.f, 0.f, 1.f}) sf(v);                         // 48: normals
+    for (int i = 0; i < 4; ++i) for (float v : {.1f, 0.f, 0.f}) sf(v);                         // 96: morph deltas
+    for (int i = 0; i < 4; ++i) for (std::uint16_t v : {0, 1, 0, 0}) su(v);                    // 144: joints
+    for (float v : {1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, .5f, .5f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f}) sf(v);  // 176: weights
+    for (float m : {1.f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 0.f, 1.f,
+                    1.f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, -1.f, 0.f, 1.f}) sf(m);  // 240: ibm
+    for (float v : {0.f, 1.f}) sf(v);                                                           // 368: times
+    for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, .7071f, 0.f, .7071f}) sf(v);                       // 376: rotations
+    for (float v : {0.f, 0.f, 0.f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f}) sf(v);                        // 408: cubic weights
+    for (float v : {0.f, 0.f, 0.f, 0.f, 2.f, 0.f}) sf(v);                                       // 444: translations
+    for (std::uint16_t v : {0, 1, 3, 0, 3, 2}) su(v);                                           // 468: indices
+    const std::string skin =
+        R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_lights_punctual"],)"
+        R"("extensions":{"KHR_lights_punctual":{"lights":[{"type":"point","intensity":3}]}},)"
+        R"("buffers":[{"byteLength":)" + std::to_string(sb.size()) +
+        R"(,"uri":"data:application/octet-stream;base64,)" + base64(sb) + R"("}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":48},)"
+        R"({"buffer":0,"byteOffset":96,"byteLength":48},{"buffer":0,"byteOffset":144,"byteLength":32},)"
+        R"({"buffer":0,"byteOffset":176,"byteLength":64},{"buffer":0,"byteOffset":240,"byteLength":128},)"
+        R"({"buffer":0,"byteOffset":368,"byteLength":8},{"buffer":0,"byteOffset":376,"byteLength":32},)"
+        R"({"buffer":0,"byteOffset":408,"byteLength":36},{"buffer":0,"byteOffset":444,"byteLength":24},)"
+        R"({"buffer":0,"byteOffset":468,"byteLength":12}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-0.5,0,0],"max":[0.5,1,0]},)"
+        R"({"bufferView":1,"componentType":5126,"count":4,"type":"VEC3"},)"
+        R"({"bufferView":2,"componentType":5126,"count":4,"type":"VEC3"},)"
+        R"({"bufferView":3,"componentType":5123,"count":4,"type":"VEC4"},)"
+        R"({"bufferView":4,"componentType":5126,"count":4,"type":"VEC4"},)"
+        R"({"bufferView":5,"componentType":5126,"count":2,"type":"MAT4"},)"
+        R"({"bufferView":6,"componentType":5126,"count":2,"type":"SCALAR","min":[0],"max":[1]},)"
+        R"({"bufferView":7,"componentType":5126,"count":2,"type":"VEC4"},)"
+        R"({"bufferView":8,"componentType":5126,"count":6,"type":"SCALAR"},)"
+        R"({"bufferView":9,"componentType":5126,"count":2,"type":"VEC3"},)"
+        R"({"bufferView":10,"componentType":5123,"count":6,"type":"SCALAR"}],)"
+        R"("meshes":[{"weights":[0.5],"primitives":[{"attributes":{"POSITION":0,"NORMAL":1,"JOINTS_0":3,"WEIGHTS_0":4},)"
+        R"("targets":[{"POSITION":2}],"indices":10}]}],)"
+        R"("skins":[{"joints":[0,1],"inverseBindMatrices":5}],)"
+        R"("cameras":[{"type":"perspective","perspective":{"yfov":0.8,"znear":0.1}},)"
+        R"({"type":"orthographic","orthographic":{"xmag":1,"ymag":1,"znear":0.1,"zfar":10}}],)"
+        R"("nodes":[{"children":[1]},{"translation":[0,1,0]},{"mesh":0,"skin":0},)"
+        R"({"camera":0,"translation":[0,0,3],"children":[4]},{"camera":1,"extensions":{"KHR_lights_punctual":{"light":0}}}],)"
+        R"("scenes":[{"nodes":[0,2,3]}],)"
+        R"("animations":[{"name":"bend","samplers":[{"input":6,"output":7},{"input":6,"output":8,"interpolation":"CUBICSPLINE"},)"
+        R"({"input":6,"output":9,"interpolation":"STEP"}],)"
+        R"("channels":[{"sampler":0,"target":{"node":1,"path":"rotation"}},{"sampler":1,"target":{"node":2,"path":"weights"}},)"
+        R"({"sampler":2,"target":{"node":3,"path":"translation"}}]}]})";
+    put("gltf", "skin-morph-animation.gltf", skin);
     put("gltf", "min-version.gltf",
         R"({"asset":{"version":"2.1","minVersion":"2.1"},"buffers":[{"uri":"b.bin","byteLength":256}],)"
         R"("bufferViews":[{"buffer":0,"byteLength":36}],)"

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "apps/render_options.h"
+#include "scene/animation.h"
 #include "scene/image.h"
 #include "scene/load_scene.h"
 
@@ -84,7 +85,20 @@ inline void run_gltf(const std::string& dir, const std::uint8_t* data, std::size
     const std::string path = dir + (glb ? "/model.glb" : "/model.gltf");
     write_file(path, data, size);
     try {
-        (void)load_gltf(path).bounds();
+        Scene scene = load_gltf(path);
+        (void)scene.bounds();
+        // Posing cannot fail once loaded (scene/animation.h): every
+        // animation and each alone, at times before, inside and after the
+        // keys, and every camera at one of them.
+        if (scene.source) {
+            const double t = double(size % 97) / 13.0 - 1.0;
+            pose_scene(scene, t, kAllAnimations);
+            for (int a = 0; a < int(scene.animation_names.size()) && a < 4; ++a) pose_scene(scene, t * 2.0, a);
+            pose_scene(scene, 0.0, kNoAnimation);
+            for (int c = 0; c < int(scene.cameras.size()) && c < 4; ++c)
+                (void)scene_camera(scene, c, t, 1.5f, kAllAnimations);
+            (void)scene.bounds();
+        }
     } catch (const LoadError&) {
     }
 }

@@ -70,6 +70,9 @@ CameraFault FrameSetup::set_frame(int index, double radians) {
     if (scene.source && !scene.animation_names.empty() && t != time) {
         pose_scene(scene, t, animation);
         time = t;
+        // The file's lights move with their nodes.
+        settings.lights = frame_lights(scene, request.lights, request.no_default_lights,
+                                       scene.environment || !request.env.empty(), used_default_rig);
         bounds = first_bounds;
         const Bounds now = scene.bounds();
         if (!now.empty()) {
@@ -122,13 +125,14 @@ FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameSt
     out.time = req.time;
     if (out.scene.source && !out.scene.animation_names.empty()) pose_scene(out.scene, req.time, out.animation);
 
-    // The camera: the built-in scene's own, or framed on the bounds; the
+    // The camera: the built-in scene's own, or framed on its vertices; the
     // flags override single fields.
     out.bounds = out.scene.bounds();
     out.first_bounds = out.bounds;
     if (out.file_camera >= 0) {
         out.base_camera = scene_camera(out.scene, out.file_camera, out.time, out.aspect(), out.animation);
-    } else if (CameraFault f = request_camera(req.camera_request(), out.bounds, out.aspect(), !req.scene.empty(),
+    } else if (CameraFault f = request_camera(req.camera_request(), out.bounds, out.aspect(),
+                                              req.scene.empty() ? nullptr : &out.scene,
                                               camera, out.base_camera)) {
         return {f.kind == CameraFault::Flag ? kFrameExitUsage : kFrameExitBadFile, f.message};
     }

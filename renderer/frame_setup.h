@@ -73,9 +73,10 @@ struct FrameRequest {
     std::string animation;
     std::string camera;
     double fps = 0.0;
+    double orbit_deg = 0.0;                  // a turntable's sweep: the default framing holds over it
 
     CameraRequest camera_request() const {
-        return {scene, eye, target, up, fov_deg, near_plane, far_plane};
+        return {scene, eye, target, up, fov_deg, near_plane, far_plane, orbit_deg};
     }
 };
 

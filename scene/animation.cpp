@@ -143,10 +143,6 @@ void pose_scene(Scene& scene, double t, int animation) {
     if (!scene.source) return;
     const SceneSource& src = *scene.source;
     const NodePose pose = pose_nodes(src, t, animation);
-    // The loader turned the winding and the tangent handedness of mirrored
-    // instances by their rest transform; the meshes keep those indices.
-    const NodePose rest = animation == kNoAnimation && t == 0.0 ? NodePose() : pose_nodes(src, 0.0, kNoAnimation);
-    const NodePose& rest_pose = rest.world.empty() ? pose : rest;
 
     std::vector<glm::dmat4> joint_matrices;
     for (Mesh& mesh : scene.meshes) {
@@ -171,7 +167,10 @@ void pose_scene(Scene& scene, double t, int animation) {
         const glm::dmat4& world = pose.world[ni];
         const glm::dmat3 linear(world);
         const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
-        const bool mirrored = glm::determinant(glm::dmat3(rest_pose.world[ni])) < 0.0;
+        // glTF 2.0, "Meshes": the determinant of the node's world transform
+        // sets the winding; an animated scale may turn it over. A skinned
+        // mesh keeps the loader's (its node's transform is not applied).
+        const bool mirrored = skinned ? mesh.mirrored : glm::determinant(linear) < 0.0;
         const std::vector<double>& weights = pose.weights[ni];
         const bool triangles = mesh.topology == Mesh::Topology::Triangles;
         // The loader keeps the file's tangents when the mesh has a UV set
@@ -234,6 +233,11 @@ void pose_scene(Scene& scene, double t, int animation) {
                 mesh.tangents[j] = glm::vec4(glm::vec3(wt), mirrored ? -tw : tw);
             }
         }
+        if (mirrored != mesh.mirrored) {
+            if (triangles)
+                for (std::size_t k = 0; k + 2 < mesh.indices.size(); k += 3) std::swap(mesh.indices[k + 1], mesh.indices[k + 2]);
+            mesh.mirrored = mirrored;
+        }
         // finish_scene's rules: triangles get computed normals where the
         // file's are missing or unusable; lines and points have none then.
         if (!triangles) {
@@ -251,6 +255,20 @@ void pose_scene(Scene& scene, double t, int animation) {
         if (tuv.empty() || mesh.normals.empty()) mesh.tangents.clear();
         else if (!file_tangents || mesh.tangents.size() != mesh.positions.size() || !scene_detail::repair_tangents(mesh))
             compute_tangents(mesh, tuv);
+    }
+    // Lights follow their nodes (KHR_lights_punctual: at the node's origin,
+    // shining along its -Z), as the loader placed them.
+    for (Light& light : scene.lights) {
+        if (light.source_node < 0 || std::size_t(light.source_node) >= pose.world.size()) continue;
+        const glm::dmat4& world = pose.world[std::size_t(light.source_node)];
+        if (light.type == Light::Type::Directional) {
+            const glm::dvec3 towards = glm::dmat3(world) * glm::dvec3(0.0, 0.0, 1.0);
+            const double len = glm::length(towards);
+            if (len > 0.0 && std::isfinite(len)) light.direction = glm::vec3(towards / len);
+        } else {
+            const glm::vec3 p(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+            if (finite3(p)) light.position = p;
+        }
     }
     ++scene.pose_serial;
 }

@@ -30,6 +30,15 @@ struct Camera {
 // the bounding sphere to fit the vertical field of view.
 Camera frame_bounds(const Bounds& b, float fov_y_deg, float aspect);
 
+// The default view of a file's scene: from the same direction as
+// frame_bounds, placed so that the projection of every vertex fills the
+// tighter axis of the frame less a margin (kFrameFill of it), centred on the
+// frame. With orbit_deg > 0 the distance also keeps every vertex inside the
+// frame when the eye turns that far around the target (render's turntable).
+// Falls back to frame_bounds when the vertices span no area in view.
+constexpr double kFrameFill = 0.9;
+Camera frame_scene(const Scene& scene, float fov_y_deg, float aspect, double orbit_deg = 0.0);
+
 // Near/far planes that enclose the bounding sphere as seen from the eye.
 void fit_clip_planes(Camera& cam, const Bounds& b);
 

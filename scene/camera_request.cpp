@@ -74,15 +74,15 @@ glm::vec3 rotate_around(const glm::vec3& v, const glm::vec3& k, double radians) 
 
 } // namespace
 
-CameraFault request_camera(const CameraRequest& req, const Bounds& bounds, float aspect, bool framed,
+CameraFault request_camera(const CameraRequest& req, const Bounds& bounds, float aspect, const Scene* framed,
                            const Camera& own, Camera& out) {
-    Camera camera = framed ? frame_bounds(bounds, req.fov_deg, aspect) : own;
+    Camera camera = framed ? frame_scene(*framed, req.fov_deg, aspect, req.orbit_deg) : own;
     camera.fov_y_deg = req.fov_deg;
     if (req.eye) camera.eye = *req.eye;
     if (req.target) camera.target = *req.target;
     // Normalised in double: a float normalize of a huge --up overflows.
     if (req.up) camera.up = glm::vec3(glm::normalize(glm::dvec3(*req.up)));
-    if (CameraFault f = check_camera(camera, req, bounds, framed)) return f;
+    if (CameraFault f = check_camera(camera, req, bounds, framed != nullptr)) return f;
     out = camera;
     return {};
 }

@@ -25,6 +25,7 @@ struct CameraRequest {
     std::optional<glm::vec3> eye, target, up;
     float fov_deg = 45.0f;
     std::optional<float> near_plane, far_plane;
+    double orbit_deg = 0.0;                  // a turntable's sweep, which the framing must hold over
 };
 
 // Why a camera cannot render: a flag is at fault (render's exit 2) or the
@@ -36,9 +37,10 @@ struct CameraFault {
 };
 
 // The turntable's base camera: `own` (the built-in scene's camera) when
-// `framed` is false, else the framing of `bounds` at the request's field of
-// view; then the flags. A fault names what is wrong.
-CameraFault request_camera(const CameraRequest& request, const Bounds& bounds, float aspect, bool framed,
+// `framed` is null, else the framing of that scene (frame_scene, at the
+// request's field of view and orbit); then the flags. `bounds` are the
+// scene's. A fault names what is wrong.
+CameraFault request_camera(const CameraRequest& request, const Bounds& bounds, float aspect, const Scene* framed,
                            const Camera& own, Camera& out);
 
 // Frame `angle` (radians) of the turntable around the base camera's target

@@ -1311,6 +1311,7 @@ private:
                 mesh.tangents[i] = glm::vec4(glm::vec3(t), mirrored ? -w : w);
             }
         }
+        mesh.mirrored = mirrored;
         if (triangles) {
             if (mirrored)
                 for (std::size_t t = 0; t < indices.size(); t += 3) std::swap(indices[t + 1], indices[t + 2]);
@@ -1448,6 +1449,7 @@ private:
         }
         const tinygltf::Light& gl = model_.lights[std::size_t(li)];
         Light light;
+        light.source_node = int(index);
         if (gl.color.size() == 3 && finite_values(gl.color))
             light.color = glm::vec3(gl.color[0], gl.color[1], gl.color[2]);
         light.intensity = std::isfinite(gl.intensity) ? float(gl.intensity) : 1.0f;

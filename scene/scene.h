@@ -99,6 +99,9 @@ struct Mesh {
     // Strips, fans and loops are turned into these lists by the loaders.
     enum class Topology { Triangles, Lines, Points };
     Topology topology = Topology::Triangles;
+    // Placed by a mirroring transform (negative determinant): the loader
+    // reversed the triangles' winding and the tangents' handedness.
+    bool mirrored = false;
     // Where a glTF mesh came from, for posing (scene/animation.h): the node
     // that instances it and the primitive's index in its mesh; -1 elsewhere.
     int source_node = -1, source_primitive = -1;
@@ -114,6 +117,7 @@ struct Light {
     glm::vec3 position{0.0f};              // point
     glm::vec3 color{1.0f};
     float intensity = 1.0f;                // radiance = color * intensity (/ d^2 for points)
+    int source_node = -1;                  // the glTF node that places it (posed by scene/animation.h)
 };
 
 struct Bounds {

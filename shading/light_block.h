@@ -38,10 +38,11 @@ struct RadianceBlock {
     alignas(64) float r[kBlockLanes], g[kBlockLanes], b[kBlockLanes];
 };
 
-// Per-lane view direction, F0, alpha and k, computed once per block.
+// Per-lane view direction, the shading normal facing it (facing_normal()),
+// F0, alpha and k, computed once per block.
 struct ViewLanes {
     static constexpr int N = kBlockLanes;
-    alignas(64) float vx[N], vy[N], vz[N], F0r[N], F0g[N], F0b[N], alpha[N], kdir[N], rough[N];
+    alignas(64) float vx[N], vy[N], vz[N], Nx[N], Ny[N], Nz[N], F0r[N], F0g[N], F0b[N], alpha[N], kdir[N], rough[N];
 };
 
 // --energy conserve factors of apply_energy_terms(), per lane and channel.
@@ -54,6 +55,12 @@ namespace light_block_detail {
 
 [[gnu::always_inline]] inline float clamp01(float x) {
     x = x < 0.0f ? 0.0f : x;
+    return x > 1.0f ? 1.0f : x;
+}
+
+// glm::clamp(x, kMinNoV, 1): the n.v the DFG tables are read at.
+[[gnu::always_inline]] inline float clamp_nov(float x) {
+    x = x < kMinNoV ? kMinNoV : x;
     return x > 1.0f ? 1.0f : x;
 }
 
@@ -86,7 +93,7 @@ inline void energy_lanes(const MaterialBlock& __restrict m, const ViewLanes& __r
     using light_block_detail::clamp01;
     alignas(64) float NoV[N], A[N], B[N], Kd[N];
     for (int l = 0; l < N; ++l)
-        NoV[l] = clamp01(m.Nx[l] * w.vx[l] + m.Ny[l] * w.vy[l] + m.Nz[l] * w.vz[l]);
+        NoV[l] = light_block_detail::clamp_nov(w.Nx[l] * w.vx[l] + w.Ny[l] * w.vy[l] + w.Nz[l] * w.vz[l]);
     light_block_detail::dfg_lanes<N>(table, NoV, w.rough, A, B, Kd);
     for (int l = 0; l < N; ++l) {
         const float km = 1.0f - m.metallic[l];
@@ -144,13 +151,13 @@ inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L
         float hl2 = hx * hx + hy * hy + hz * hz;
         bool hok = hl2 > 0.0f;
         float hs = std::sqrt(hok ? hl2 : 1.0f);
-        hx = hok ? hx / hs : m.Nx[l];
-        hy = hok ? hy / hs : m.Ny[l];
-        hz = hok ? hz / hs : m.Nz[l];
+        hx = hok ? hx / hs : w.Nx[l];
+        hy = hok ? hy / hs : w.Ny[l];
+        hz = hok ? hz / hs : w.Nz[l];
         auto clamp01 = [](float x) { x = x < 0.0f ? 0.0f : x; return x > 1.0f ? 1.0f : x; };
-        float NoL = clamp01(m.Nx[l] * lx + m.Ny[l] * ly + m.Nz[l] * lz);
-        float NoV = clamp01(m.Nx[l] * vx[l] + m.Ny[l] * vy[l] + m.Nz[l] * vz[l]);
-        float NoH = clamp01(m.Nx[l] * hx + m.Ny[l] * hy + m.Nz[l] * hz);
+        float NoL = clamp01(w.Nx[l] * lx + w.Ny[l] * ly + w.Nz[l] * lz);
+        float NoV = clamp01(w.Nx[l] * vx[l] + w.Ny[l] * vy[l] + w.Nz[l] * vz[l]);
+        float NoH = clamp01(w.Nx[l] * hx + w.Ny[l] * hy + w.Nz[l] * hz);
         float VoH = clamp01(vx[l] * hx + vy[l] * hy + vz[l] * hz);
         // F (Schlick), D, G or V.
         float fc = brdf_detail::pow5(1.0f - (VoH < 0.0f ? 0.0f : VoH));
@@ -202,16 +209,16 @@ inline void ibl_lanes(const MaterialBlock& __restrict m, const ViewLanes& __rest
     alignas(64) std::int32_t la[N], lb[N];
     // Reflection direction, its map direction and (u, v); the level pair.
     for (int l = 0; l < N; ++l) {
-        const float d = m.Nx[l] * w.vx[l] + m.Ny[l] * w.vy[l] + m.Nz[l] * w.vz[l];
-        NoV[l] = clamp01(d);
+        const float d = w.Nx[l] * w.vx[l] + w.Ny[l] * w.vy[l] + w.Nz[l] * w.vz[l];
+        NoV[l] = light_block_detail::clamp_nov(d);
         const float d2 = 2.0f * d;
-        const float Mx = m.Nx[l] * d2 - w.vx[l], My = m.Ny[l] * d2 - w.vy[l], Mz = m.Nz[l] * d2 - w.vz[l];
+        const float Mx = w.Nx[l] * d2 - w.vx[l], My = w.Ny[l] * d2 - w.vy[l], Mz = w.Nz[l] * d2 - w.vz[l];
         // Bent towards n with roughness (ibl_terms()).
         const float a = w.rough[l] * w.rough[l];
         const float f = a * a;
         const float rf = 1.0f - f;
-        const float Rx = Mx * rf + m.Nx[l] * f, Rz = Mz * rf + m.Nz[l] * f;
-        Ry[l] = My * rf + m.Ny[l] * f;
+        const float Rx = Mx * rf + w.Nx[l] * f, Rz = Mz * rf + w.Nz[l] * f;
+        Ry[l] = My * rf + w.Ny[l] * f;
         mx[l] = Rx * rc - Rz * rs;
         mz[l] = Rx * rs + Rz * rc;
         // prefiltered_taps(): the level pair and t.
@@ -246,9 +253,9 @@ inline void ibl_lanes(const MaterialBlock& __restrict m, const ViewLanes& __rest
     alignas(64) float Er[N], Eg[N], Eb[N];
     const ShIrradiance& sh = env.sh();
     for (int l = 0; l < N; ++l) {
-        const float er = sh_irradiance_eval(&sh.c[0][0], m.Nx[l], m.Ny[l], m.Nz[l]);
-        const float eg = sh_irradiance_eval(&sh.c[0][1], m.Nx[l], m.Ny[l], m.Nz[l]);
-        const float eb = sh_irradiance_eval(&sh.c[0][2], m.Nx[l], m.Ny[l], m.Nz[l]);
+        const float er = sh_irradiance_eval(&sh.c[0][0], w.Nx[l], w.Ny[l], w.Nz[l]);
+        const float eg = sh_irradiance_eval(&sh.c[0][1], w.Nx[l], w.Ny[l], w.Nz[l]);
+        const float eb = sh_irradiance_eval(&sh.c[0][2], w.Nx[l], w.Ny[l], w.Nz[l]);
         Er[l] = er > 0.0f ? er : 0.0f;
         Eg[l] = eg > 0.0f ? eg : 0.0f;
         Eb[l] = eb > 0.0f ? eb : 0.0f;
@@ -322,6 +329,15 @@ inline void shade_block_lanes(const MaterialBlock& __restrict m, const ShadingCo
         w.vx[l] = ok ? dx / s : m.Nx[l];
         w.vy[l] = ok ? dy / s : m.Ny[l];
         w.vz[l] = ok ? dz / s : m.Nz[l];
+        // facing_normal(): bent towards v where it faces away.
+        const float d = m.Nx[l] * w.vx[l] + m.Ny[l] * w.vy[l] + m.Nz[l] * w.vz[l];
+        const bool bend = d < kMinNoV;
+        const float k = kMinNoV - d;
+        const float bx = m.Nx[l] + w.vx[l] * k, by = m.Ny[l] + w.vy[l] * k, bz = m.Nz[l] + w.vz[l] * k;
+        const float bl = std::sqrt(bend ? bx * bx + by * by + bz * bz : 1.0f);
+        w.Nx[l] = bend ? bx / bl : m.Nx[l];
+        w.Ny[l] = bend ? by / bl : m.Ny[l];
+        w.Nz[l] = bend ? bz / bl : m.Nz[l];
         float mt = m.metallic[l];
         w.F0r[l] = f0 * (1.0f - mt) + m.ar[l] * mt;
         w.F0g[l] = f0 * (1.0f - mt) + m.ag[l] * mt;

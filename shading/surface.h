@@ -189,6 +189,29 @@ inline glm::vec4 fetch(const Texture* tex, const SurfacePoint& sp, int set, floa
 
 } // namespace surface_detail
 
+// The least n.v the shading reads (docs/shading.md, "Normals that face
+// away"). A shading normal turned away from the eye -- a normal map's slope
+// on the far side of a bump, an interpolated normal just past a silhouette,
+// the back of a coincident double-sided pair -- would give n.v = 0, a DFG of
+// 0 and a black pixel where Filament and the Khronos viewer show a grazing
+// reflection. So the normal is bent towards v until n.v reaches kMinNoV (the
+// floor Filament puts on n.v), and the DFG tables are read at n.v >= kMinNoV.
+// Normals that face the eye keep their bits.
+constexpr float kMinNoV = 1e-4f;
+
+// n bent towards the unit view direction v when n.v < kMinNoV: n's component
+// along v replaced by kMinNoV, n + v (kMinNoV - n.v), normalised; its n.v is
+// then at least kMinNoV, and it stays in the plane of n and v. The lane code
+// (light_block.h) does the same operations.
+inline glm::vec3 facing_normal(const glm::vec3& n, const glm::vec3& v) {
+    const float d = n.x * v.x + n.y * v.y + n.z * v.z;
+    if (!(d < kMinNoV)) return n;
+    const float k = kMinNoV - d;
+    const float bx = n.x + v.x * k, by = n.y + v.y * k, bz = n.z + v.z * k;
+    const float len = std::sqrt(bx * bx + by * by + bz * bz);
+    return glm::vec3(bx / len, by / len, bz / len);
+}
+
 inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoint& sp, const MaterialLods& lods) {
     const Material& m = *bm.m;
     MaterialSample s;
@@ -249,7 +272,7 @@ inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoin
 // channel, comp = 1 + F0 (1 / (A + B) - 1), E_spec = (F0 A + B) comp,
 // kd = (1 - E_spec)(1 - metallic). The lane code does the same operations.
 inline void apply_energy_terms(BrdfInputs& in, const DfgTable& table) {
-    const float NoV = glm::clamp(glm::dot(in.n, in.v), 0.0f, 1.0f);
+    const float NoV = glm::clamp(glm::dot(in.n, in.v), kMinNoV, 1.0f);
     const float r = glm::clamp(in.roughness, kMinPerceptualRoughness, 1.0f);
     const glm::vec4 ab = table.lookup(NoV, r);
     const glm::vec3 F0 = brdf_f0(in);
@@ -269,8 +292,8 @@ inline void apply_energy_terms(BrdfInputs& in, const DfgTable& table) {
 // different tables.
 inline BrdfInputs plain_brdf_inputs(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx) {
     BrdfInputs in;
-    in.n = ms.N;
     in.v = surface_detail::safe_normalize(ctx.eye - sp.P, ms.N);
+    in.n = facing_normal(ms.N, in.v);
     in.albedo = ms.albedo;
     in.metallic = ms.metallic;
     in.roughness = ms.roughness;
@@ -293,6 +316,7 @@ inline BrdfInputs brdf_inputs(const MaterialSample& ms, const SurfacePoint& sp, 
 // averaged over the cosine lobe, dfg.h), or with --energy conserve the
 // specular times comp and kd = (1 - E_spec)(1 - metallic).
 struct IblTerms {
+    glm::vec3 N{0.0f};             // the normal shaded with: ms.N, bent towards v if it faced away
     glm::vec3 irradiance{0.0f};    // E(n) / pi from the SH, n the shading normal
     glm::vec3 R{0.0f};             // the prefiltered lookup direction (reflection of v, bent to n)
     glm::vec3 prefiltered{0.0f};   // prefiltered radiance along R
@@ -311,10 +335,11 @@ struct IblTerms {
 inline IblTerms ibl_terms(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx) {
     const Environment& env = *ctx.env;
     IblTerms t;
-    const glm::vec3 n = ms.N;
     const glm::vec3 v = surface_detail::safe_normalize(ctx.eye - sp.P, ms.N);
+    const glm::vec3 n = facing_normal(ms.N, v);
+    t.N = n;
     const float d = glm::dot(n, v);
-    t.NoV = glm::clamp(d, 0.0f, 1.0f);
+    t.NoV = glm::clamp(d, kMinNoV, 1.0f);
     const float r = glm::clamp(ms.roughness, kMinPerceptualRoughness, 1.0f);
     // The lobe's dominant direction: the mirror direction bent towards n as
     // the surface roughens, mix(R, n, alpha^2) as Filament does (after

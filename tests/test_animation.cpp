@@ -611,4 +611,63 @@ TEST_CASE("hostile skins and animations: warnings or one-line errors, never a cr
     }
 }
 
+TEST_CASE("an animated scale that turns mirrored turns the winding; lights follow their animated nodes") {
+    CliSandbox box;
+    // Scale x from 1 to -1 (STEP at t = 1): the triangle (0,0,0) (1,0,0)
+    // (0,1,0) becomes (0,0,0) (-1,0,0) (0,1,0). glTF's determinant rule keeps
+    // it counter-clockwise seen from +z, so its front still faces +z.
+    Gltf g = animated_triangle("scale", "STEP", {0, 1}, {1, 1, 1, -1, 1, 1}, "VEC3", 3);
+    Scene s = load_scene(g.write(box, "mirror.gltf"));
+    auto facing_z = [](const Mesh& m) {
+        REQUIRE(m.indices.size() == 3);
+        const glm::vec3 a = m.positions[m.indices[0]], b = m.positions[m.indices[1]], c = m.positions[m.indices[2]];
+        return glm::cross(b - a, c - a).z;
+    };
+    CHECK(facing_z(s.meshes[0]) > 0.0f);
+    pose_scene(s, 1.0, kAllAnimations);
+    check_vec(s.meshes[0].positions[1], {-1, 0, 0});
+    CHECK(s.meshes[0].mirrored);
+    CHECK(facing_z(s.meshes[0]) > 0.0f);
+    pose_scene(s, 0.0, kAllAnimations);
+    CHECK(!s.meshes[0].mirrored);
+    CHECK(facing_z(s.meshes[0]) > 0.0f);
+
+    // A point light and a sun under an animated rig node, translated from
+    // (0, 0, 0) to (0, 0, 2) over a second; the triangle stays.
+    Gltf l = animated_triangle("translation", "LINEAR", {0, 1}, {0, 0, 0, 0, 0, 2}, "VEC3", 3);
+    l.doc["animations"][0]["channels"][0]["target"]["node"] = 2;
+    l.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    l.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array(
+        {{{"type", "point"}, {"intensity", 5}}, {{"type", "directional"}, {"intensity", 2}}});
+    const double h = std::sqrt(0.5);
+    l.doc["nodes"].push_back({{"name", "rig"}, {"children", {3, 4}}});
+    l.doc["nodes"].push_back({{"translation", {0, 1, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    l.doc["nodes"].push_back({{"rotation", {0, h, 0, h}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+    l.doc["scenes"] = json::array({{{"nodes", {0, 2}}}});
+    l.doc["scene"] = 0;
+    const std::string lf = l.write(box, "lights.gltf");
+    Scene ls = load_scene(lf);
+    REQUIRE(ls.lights.size() == 2);
+    check_vec(ls.lights[0].position, {0, 1, 0});
+    check_vec(ls.lights[1].direction, {1, 0, 0});  // the node's +z turned about y
+    pose_scene(ls, 1.0, kAllAnimations);
+    check_vec(ls.lights[0].position, {0, 1, 2});
+    check_vec(ls.lights[1].direction, {1, 0, 0});
+    pose_scene(ls, 0.5, kAllAnimations);
+    check_vec(ls.lights[0].position, {0, 1, 1});
+    // Through render: only the light moves, and the pixels change with it;
+    // a sequence's frame 1 equals a still at its time.
+    const std::vector<std::string> common = {lf, "--size", "64x64", "--eye", "0.3,0.3,4", "--target", "0.3,0.3,0"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> v = common;
+        v.insert(v.end(), extra.begin(), extra.end());
+        return v;
+    };
+    REQUIRE(box.run_exe(kRender, with({"--time", "0", "-o", "l0.png"})).code == 0);
+    REQUIRE(box.run_exe(kRender, with({"--time", "1", "-o", "l1.png"})).code == 0);
+    CHECK(read_bytes(box.path("l0.png")) != read_bytes(box.path("l1.png")));
+    REQUIRE(box.run_exe(kRender, with({"--frames", "2", "--fps", "1", "-o", "s%d.png"})).code == 0);
+    CHECK(read_bytes(box.path("s1.png")) == read_bytes(box.path("l1.png")));
+}
+
 } // TEST_SUITE

@@ -7,6 +7,7 @@
 // gives; refusals run through the built `render` as a user meets them.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -16,6 +17,7 @@
 
 #include <stb_image_write.h>
 
+#include "scene/camera.h"
 #include "scene/image.h"
 #include "scene/load_scene.h"
 #include "tests/cli_util.h"
@@ -744,6 +746,85 @@ TEST_CASE("fuzzed files with the new features load sane scenes or throw one-line
     MESSAGE("gltf_core fuzz: " << loaded << " loaded, " << rejected << " rejected");
     CHECK(loaded > 0);
     CHECK(loaded + rejected == 300);
+}
+
+// The extremes of the vertices' projection (NDC) through `cam`.
+struct Ndc {
+    double x0 = 1e30, x1 = -1e30, y0 = 1e30, y1 = -1e30;
+};
+Ndc project_all(const Scene& s, const Camera& cam, float aspect) {
+    const glm::dmat4 vp = glm::dmat4(cam.projection(aspect)) * glm::dmat4(cam.view());
+    Ndc n;
+    for (const Mesh& m : s.meshes)
+        for (const glm::vec3& p : m.positions) {
+            const glm::dvec4 c = vp * glm::dvec4(glm::dvec3(p), 1.0);
+            n.x0 = std::min(n.x0, c.x / c.w), n.x1 = std::max(n.x1, c.x / c.w);
+            n.y0 = std::min(n.y0, c.y / c.w), n.y1 = std::max(n.y1, c.y / c.w);
+        }
+    return n;
+}
+
+TEST_CASE("default framing: the vertices fill 90% of the tighter axis, centred; a turntable keeps them in frame") {
+    // A long bar off the origin and a random cloud: the bounding sphere of
+    // either leaves the model small.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (int shape = 0; shape < 2; ++shape)
+        for (const float aspect : {16.0f / 9.0f, 1.0f, 0.5f}) {
+            Scene s;
+            Mesh m;
+            if (shape == 0) {
+                for (float x : {-4.0f, 4.0f})
+                    for (float y : {0.0f, 0.5f})
+                        for (float z : {-0.2f, 0.2f}) m.positions.push_back({x + 10.0f, y + 3.0f, z});
+            } else {
+                for (int i = 0; i < 500; ++i) m.positions.push_back({u(rng) * 2.0f, u(rng) * 0.3f, u(rng)});
+            }
+            s.meshes.push_back(m);
+            INFO("shape " << shape << " aspect " << aspect);
+            const Camera cam = frame_scene(s, 45.0f, aspect);
+            const Ndc n = project_all(s, cam, aspect);
+            const double fill = kFrameFill, tol = 1e-4;
+            CHECK(n.x0 >= -fill - tol);
+            CHECK(n.x1 <= fill + tol);
+            CHECK(n.y0 >= -fill - tol);
+            CHECK(n.y1 <= fill + tol);
+            // One axis touches the margin on both sides; both are centred.
+            const bool x_tight = n.x1 - n.x0 > n.y1 - n.y0;
+            const double w = x_tight ? n.x1 - n.x0 : n.y1 - n.y0;
+            CHECK(w == doctest::Approx(2.0 * fill).epsilon(1e-4));
+            CHECK(std::fabs(n.x0 + n.x1) <= 1e-4);
+            CHECK(std::fabs(n.y0 + n.y1) <= 1e-4);
+            // The view direction is the documented one.
+            const glm::vec3 d = glm::normalize(cam.eye - cam.target);
+            CHECK(d.x == doctest::Approx(0.0).epsilon(1e-6));
+            CHECK(d.y / d.z == doctest::Approx(0.35).epsilon(1e-5));
+
+            // A turntable: inside the margin at the 72 sampled angles, inside
+            // the frame between them.
+            const Camera base = frame_scene(s, 45.0f, aspect, 360.0);
+            double worst = 0.0;
+            for (int k = 0; k < 144; ++k) {
+                const double t = 2.0 * 3.14159265358979323846 * k / 144.0;
+                Camera c = base;
+                const glm::dvec3 e = glm::dvec3(base.eye - base.target);
+                c.eye = base.target + glm::vec3(glm::dvec3(e.x * std::cos(t) + e.z * std::sin(t), e.y,
+                                                           -e.x * std::sin(t) + e.z * std::cos(t)));
+                const Ndc o = project_all(s, c, aspect);
+                const double reach = std::max({-o.x0, o.x1, -o.y0, o.y1});
+                if (k % 2 == 0) CHECK(reach <= fill + tol);
+                worst = std::max(worst, reach);
+            }
+            CHECK(worst < 1.0);
+        }
+    // No area in view (every vertex on one line along the view): the sphere.
+    Scene line;
+    Mesh m;
+    m.positions = {{0, 0, 0}, {0, 0.35f, 1.0f}};
+    line.meshes.push_back(m);
+    const Camera a = frame_scene(line, 45.0f, 1.0f), b = frame_bounds(line.bounds(), 45.0f, 1.0f);
+    CHECK(a.eye == b.eye);
+    CHECK(a.target == b.target);
 }
 
 } // TEST_SUITE

@@ -17,6 +17,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -39,6 +40,7 @@
 #include "fuzz/png_craft.h"
 #include "fuzz/targets.h"
 #include "raster/thread_pool.h"
+#include "scene/camera.h"
 #include "scene/file_access.h"
 #include "scene/hdr_guard.h"
 #include "scene/jpeg_guard.h"
@@ -1367,7 +1369,10 @@ TEST_CASE("absurd coordinates: the scene's bounds are blamed, or the flag that i
     CHECK(r.code == 2);
     CHECK(r.err.find(p + "--fov 0.001000: framing the scene") == 0);
     // The eye on the framed target: --eye is blamed, not --up.
-    r = render(box, {"t.obj", "--eye", "0.5,0.5,0", "--size", "16x16"});
+    const glm::vec3 framed = frame_scene(load_scene(box.path("t.obj")), 45.0f, 1.0f).target;
+    char at[96];
+    std::snprintf(at, sizeof at, "%.9g,%.9g,%.9g", double(framed.x), double(framed.y), double(framed.z));
+    r = render(box, {"t.obj", "--eye", at, "--size", "16x16"});
     CHECK(r.code == 2);
     CHECK(r.err.find(p + "--eye ") == 0);
     // Looking straight down without --up: the camera flags, with a way out.

@@ -364,4 +364,43 @@ TEST_CASE("the directional map fits the visible part of the scene, snapped to wh
     CHECK(range >= 1.0f);
 }
 
+
+TEST_CASE("a MASK caster's vertex colour alpha cuts its shadow out, as it cuts the surface") {
+    // The occluder square at y = 0.5 under a sun straight down: with vertex
+    // colour alpha 0 under a 0.5 cutoff it is discarded in the image and in
+    // the shadow map, with alpha 1 it casts as an opaque one does.
+    Camera cam;
+    cam.eye = {0.3f, 2.5f, 3.0f};
+    cam.target = {0.0f, 0.0f, 0.0f};
+    cam.near_plane = 0.5f;
+    cam.far_plane = 10.0f;
+    const int W = 128, H = 96;
+    const std::vector<ShadingLight> lights = {sun({0, 1, 0})};
+    auto scene_with_alpha = [](float alpha) {
+        Scene s = base_scene();
+        Material mask = s.materials[0];
+        mask.alpha_mode = AlphaMode::Mask;
+        mask.alpha_cutoff = 0.5f;
+        s.materials.push_back(mask);
+        add_floor(s, 2.0f);
+        add_square(s, 0.5f, 0.5f);
+        s.meshes.back().material = 1;
+        s.meshes.back().colors.assign(4, glm::vec4(1.0f, 1.0f, 1.0f, alpha));
+        return s;
+    };
+    Scene floor_only = base_scene();
+    add_floor(floor_only, 2.0f);
+    const Frame bare = render(floor_only, cam, lights, true, W, H);
+    const Frame cut = render(scene_with_alpha(0.0f), cam, lights, true, W, H);
+    const Frame kept = render(scene_with_alpha(1.0f), cam, lights, true, W, H);
+    CHECK(cut.rgba == bare.rgba);
+    // A floor point in the shadow that the occluder does not hide from the
+    // eye (the ray to it crosses y = 0.5 at z = 0.92), and one far outside.
+    const glm::vec2 c = project(cam, W, H, {0.0f, 0.0f, 0.4f});
+    const glm::vec2 e = project(cam, W, H, {1.5f, 0.0f, 1.5f});
+    CHECK(kept.r(int(c.x), int(c.y)) == 0.0f);
+    CHECK(bare.r(int(c.x), int(c.y)) > 0.0f);
+    CHECK(kept.r(int(e.x), int(e.y)) > 0.0f);
+}
+
 }

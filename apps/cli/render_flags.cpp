@@ -112,12 +112,13 @@ void add_render_flags(FlagSet& set, RenderParse& st, bool render_only) {
     {
         Flag& f = set.value({"--eye"}, "X,Y,Z", "camera position", "framed on the scene", {"1,2,x", "0,0,2e18"},
                             point(o.eye, false));
-        f.help = "Camera position. Unset: framed on the scene's bounds (the built-in scene has a camera of its "
-                 "own).";
+        f.help = "Camera position. Unset: the model framed so that its vertices fill 90% of the tighter axis of "
+                 "the image, seen from +Z a little above (the built-in scene has a camera of its own).";
         f.hints = {"camera", "position", "from", "cam", "camera-position", "look-from"};
-        Flag& t = set.value({"--target"}, "X,Y,Z", "the point looked at", "the scene's centre", {"1,2", "-1e19,0,0"},
+        Flag& t = set.value({"--target"}, "X,Y,Z", "the point looked at", "the framed centre", {"1,2", "-1e19,0,0"},
                             point(o.target, false));
-        t.help = "The point the camera looks at. Unset: the centre of the scene's bounds.";
+        t.help = "The point the camera looks at. Unset: the framing's, which centres the model's projection in "
+                 "the image.";
         t.hints = {"look-at", "lookat", "at", "center", "centre", "focus"};
         Flag& u = set.value({"--up"}, "X,Y,Z", "the camera's up direction", "0,1,0", {"0,0,0"}, point(o.up, true));
         u.help = "The camera's up direction (not zero, not along the view); the turntable orbits around it.";

@@ -27,11 +27,13 @@ struct ShadowCasterProgram {
 };
 
 // MASK and BLEND casters: the base colour's alpha against a cutoff, as the
-// PBR program's MASK test does (factor times texture, level of detail from
-// the quad's uv derivatives in the map's texels).
+// PBR program's MASK test does (factor times texture times vertex colour;
+// the texture on its own UV set and sampler, level of detail from the
+// quad's uv derivatives in the map's texels).
 struct ShadowCutoutProgram {
-    static constexpr int kVaryings = 2;
+    static constexpr int kVaryings = 3;  // u, v, the vertex colour's alpha
     const Mesh* mesh = nullptr;
+    const std::vector<glm::vec2>* uvs = nullptr;  // the base colour map's set
     const BoundMaterial* material = nullptr;
     float cutoff = 0.5f;
     glm::vec3 origin{0.0f};
@@ -40,13 +42,15 @@ struct ShadowCutoutProgram {
     void vertex(std::uint32_t i, float clip[4], float* var) const {
         const glm::vec4 c = view_proj * glm::vec4(mesh->positions[i] - origin, 1.0f);
         clip[0] = c.x; clip[1] = c.y; clip[2] = c.z; clip[3] = c.w;
-        const glm::vec2 uv = i < mesh->uvs.size() ? mesh->uvs[i] : glm::vec2(0.0f);
+        const glm::vec2 uv = i < uvs->size() ? (*uvs)[i] : glm::vec2(0.0f);
         var[0] = uv.x;
         var[1] = uv.y;
+        var[2] = i < mesh->colors.size() ? mesh->colors[i].a : 1.0f;
     }
-    void fragment(const FragmentBlock<2>& in, FragmentOut& out) const {
+    void fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
         const float factor = material->m->base_color_factor.a;
         const Texture* tex = material->base_color;
+        const bool colored = !mesh->colors.empty();
         float lod = 0.0f;
         for (int l = 0; l < kBlockLanes; ++l) {
             out.r[l] = out.g[l] = out.b[l] = out.a[l] = 0.0f;
@@ -55,8 +59,9 @@ struct ShadowCutoutProgram {
             if (tex) {
                 if (!(in.mask & (0xFu << (l & ~3)) & ((1u << l) - 1)))  // first live lane of its quad
                     lod = tex->lod(in.ddx(0, l), in.ddx(1, l), in.ddy(0, l), in.ddy(1, l));
-                alpha *= tex->sample_trilinear(in.var[0][l], in.var[1][l], lod).a;
+                alpha *= tex->sample_lod(in.var[0][l], in.var[1][l], lod).a;
             }
+            if (colored) alpha *= in.var[2][l];
             if (!(alpha >= cutoff)) out.kill |= 1u << l;
         }
     }
@@ -256,6 +261,7 @@ void ShadowMaps::draw_casters(const Scene& scene, const std::vector<BoundMateria
         } else {
             ShadowCutoutProgram prog;
             prog.mesh = &mesh;
+            prog.uvs = bm->uv.base_color == 1 ? &mesh.uvs1 : &mesh.uvs;
             prog.material = bm;
             prog.cutoff = mode == AlphaMode::Mask ? bm->m->alpha_cutoff : kBlendShadowCutoff;
             prog.origin = origin;

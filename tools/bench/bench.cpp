@@ -705,7 +705,7 @@ int bench_scene(const std::string& scene_path, int width, int height, const std:
         } else {
             loaded = load_scene(scene_path);
             scene = &loaded;
-            camera = frame_bounds(loaded.bounds(), 45.0f, aspect);
+            camera = frame_scene(loaded, 45.0f, aspect);
         }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench: %s\n", e.what());
