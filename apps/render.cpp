@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <set>
 #include <string>
 #include <system_error>
@@ -190,13 +191,126 @@ std::string check_output_paths(const cli::FramePattern& pattern, int first, int 
 }
 
 
-// The nearest triangle along pixel (x, y)'s ray, for --pixel: a brute-force
-// ray cast (Moller-Trumbore) over the scene, with the rasterizer's culling.
+// The fragment that wrote pixel (x, y), for --pixel: a stage observer
+// (raster/observer.h) on every draw of the frame keeps, sample by sample, the
+// last fragment whose depth test passed there and whose colour was written
+// (the visibility pass's winner, or a fragment shaded in order that its
+// shader kept), which is how step's pixel history finds its winner. Draws
+// and triangles are numbered as step numbers them: draws in submission
+// order, a triangle within its draw's mesh and over the frame.
 struct PixelHit {
+    int draw = -1;
     int mesh = -1;
-    std::size_t triangle = 0;
-    float u = 0.0f, v = 0.0f;  // barycentrics of vertices 1 and 2
+    std::size_t triangle = 0;        // within the mesh
+    std::uint32_t frame_triangle = 0;
+    bool front_facing = true;
+    int samples = 0;                 // of the pixel's samples it holds
+    float u = 0.0f, v = 0.0f;        // barycentrics of vertices 1 and 2 where the pixel's ray meets its plane
     glm::vec3 origin{0.0f}, dir{0.0f};
+};
+
+class PixelWinner {
+public:
+    PixelWinner(int x, int y, int samples, FrameOptions::Visibility visibility)
+        : x_(x), y_(y), bx_(x & ~(kBlockSize - 1)), by_(y & ~(kBlockSize - 1)), samples_(samples), visibility_(visibility) {
+        for (int l = 0; l < kBlockLanes; ++l)
+            if (lane_x(l) == x - bx_ && lane_y(l) == y - by_) lane_ = l;
+    }
+
+    struct Tap {
+        static constexpr bool enabled = true;
+        PixelWinner* w;
+        int draw;
+        void vertex(std::uint32_t, const float*, const float*, int) {}
+        void triangle(std::uint32_t, TriangleFate, bool, const TriangleSetup*) {}
+        void binned(std::uint32_t, int) {}
+        void fragments(std::uint32_t, int, int, std::uint32_t, std::uint32_t, const float*) {}
+        void samples(std::uint32_t prim, int bx, int by, const SampleCoverage& sc) { w->samples(draw, prim, bx, by, sc); }
+        template <int NV>
+        void shaded(const FragmentBlock<NV>& in, const FragmentOut&, std::uint32_t live) { w->shaded(draw, in, live); }
+    };
+    Tap tap(const SceneDraw& d) {
+        draws_.push_back(d);
+        visible_.push_back(shades_after_visibility(d.state, visibility_));
+        return Tap{this, int(draws_.size()) - 1};
+    }
+
+    // The fragment holding the most samples (the first of them in
+    // submission order on a tie); draw -1 when none holds one.
+    PixelHit winner() const {
+        PixelHit best;
+        std::uint64_t best_seq = 0;
+        for (int s = 0; s < samples_; ++s) {
+            const Owner& o = owner_[s];
+            if (o.draw < 0) continue;
+            int n = 0;
+            for (int t = 0; t < samples_; ++t) n += owner_[t].seq == o.seq && owner_[t].draw >= 0;
+            if (n > best.samples || (n == best.samples && o.seq < best_seq)) {
+                const SceneDraw& d = draws_[std::size_t(o.draw)];
+                best.draw = o.draw;
+                best.mesh = d.mesh;
+                best.triangle = o.prim;
+                best.frame_triangle = d.first_triangle + o.prim;
+                best.front_facing = o.front;
+                best.samples = n;
+                best_seq = o.seq;
+            }
+        }
+        return best;
+    }
+
+private:
+    struct Owner {
+        int draw = -1;
+        std::uint32_t prim = 0;
+        bool front = true;
+        std::uint64_t seq = 0;  // the fragment's place in the tile's sequence
+    };
+
+    // The pixel's tile is run by one thread at a time, in submission order,
+    // so these calls for its block arrive in order.
+    void samples(int draw, std::uint32_t prim, int bx, int by, const SampleCoverage& sc) {
+        if (bx != bx_ || by != by_) return;
+        std::uint32_t pass = 0;
+        for (int s = 0; s < sc.count; ++s) pass |= ((sc.pass[s] >> lane_) & 1u) << s;
+        pending_samples_ = 0;
+        if (!pass) return;
+        const Owner o{draw, prim, true, ++seq_};
+        if (visible_[std::size_t(draw)]) {
+            // Depth written: the sample's winner so far, shaded later.
+            for (int s = 0; s < samples_; ++s)
+                if ((pass >> s) & 1u) owner_[s] = o;
+        } else {
+            pending_ = o;  // written only if the shader keeps it
+            pending_samples_ = pass;
+        }
+    }
+
+    template <int NV>
+    void shaded(int draw, const FragmentBlock<NV>& in, std::uint32_t live) {
+        if (in.x != bx_ || in.y != by_ || !((in.mask >> lane_) & 1u)) return;
+        if (visible_[std::size_t(draw)]) {
+            for (int s = 0; s < samples_; ++s)
+                if (owner_[s].draw == draw && owner_[s].prim == in.prim_id) owner_[s].front = in.front_facing;
+            return;
+        }
+        if (!pending_samples_ || pending_.draw != draw || pending_.prim != in.prim_id) return;
+        if ((live >> lane_) & 1u) {
+            pending_.front = in.front_facing;
+            for (int s = 0; s < samples_; ++s)
+                if ((pending_samples_ >> s) & 1u) owner_[s] = pending_;
+        }
+        pending_samples_ = 0;
+    }
+
+    int x_, y_, bx_, by_, lane_ = 0, samples_;
+    FrameOptions::Visibility visibility_;
+    std::vector<SceneDraw> draws_;
+    std::vector<bool> visible_;
+    Owner owner_[kMaxSamples];
+    Owner pending_;
+    std::uint32_t pending_samples_ = 0;
+    std::uint64_t seq_ = 0;
 };
 
 // The ray through pixel centre (x, y): origin on the near plane, direction to the far plane.
@@ -209,44 +323,19 @@ void pixel_ray(const Camera& cam, int width, int height, glm::vec2 px, glm::vec3
     dir = glm::vec3(b) / b.w - origin;
 }
 
-PixelHit cast_pixel_ray(const Scene& scene, const Camera& cam, int width, int height, glm::ivec2 px) {
-    glm::vec3 origin, dir;
-    pixel_ray(cam, width, height, glm::vec2(px), origin, dir);
-    PixelHit hit;
-    hit.origin = origin;
-    hit.dir = dir;
-    float best = 1.0f;  // ray parameter: 0 at the near plane, 1 at the far plane
-    for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
-        const Mesh& mesh = scene.meshes[m];
-        if (mesh.topology != Mesh::Topology::Triangles) continue;  // a ray meets no 1-pixel line
-        const bool two_sided = mesh.material >= 0 && std::size_t(mesh.material) < scene.materials.size() &&
-                               scene.materials[std::size_t(mesh.material)].double_sided;
-        for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-            const glm::vec3& p0 = mesh.positions[mesh.indices[t]];
-            const glm::vec3 e1 = mesh.positions[mesh.indices[t + 1]] - p0;
-            const glm::vec3 e2 = mesh.positions[mesh.indices[t + 2]] - p0;
-            // Front faces wind counter-clockwise as seen: their normal faces the ray.
-            if (!two_sided && glm::dot(glm::cross(e1, e2), dir) >= 0.0f) continue;
-            const glm::vec3 p = glm::cross(dir, e2);
-            const float det = glm::dot(e1, p);
-            if (det == 0.0f) continue;
-            const glm::vec3 s = origin - p0;
-            const float u = glm::dot(s, p) / det;
-            if (u < 0.0f || u > 1.0f) continue;
-            const glm::vec3 q = glm::cross(s, e1);
-            const float v = glm::dot(dir, q) / det;
-            if (v < 0.0f || u + v > 1.0f) continue;
-            const float tr = glm::dot(e2, q) / det;
-            if (tr >= 0.0f && tr < best) {
-                best = tr;
-                hit.mesh = int(m);
-                hit.triangle = t / 3;
-                hit.u = u;
-                hit.v = v;
-            }
-        }
-    }
-    return hit;
+// Where the pixel's ray meets the winning triangle's plane (Moller-Trumbore):
+// the barycentrics the environment's terms are evaluated at.
+void ray_on_triangle(const Mesh& mesh, const Camera& cam, int width, int height, glm::ivec2 px, PixelHit& hit) {
+    pixel_ray(cam, width, height, glm::vec2(px), hit.origin, hit.dir);
+    const glm::vec3& p0 = mesh.positions[mesh.indices[hit.triangle * 3]];
+    const glm::vec3 e1 = mesh.positions[mesh.indices[hit.triangle * 3 + 1]] - p0;
+    const glm::vec3 e2 = mesh.positions[mesh.indices[hit.triangle * 3 + 2]] - p0;
+    const glm::vec3 p = glm::cross(hit.dir, e2);
+    const float det = glm::dot(e1, p);
+    if (det == 0.0f) return;
+    const glm::vec3 s = hit.origin - p0;
+    hit.u = glm::dot(s, p) / det;
+    hit.v = glm::dot(hit.dir, glm::cross(s, e1)) / det;
 }
 
 // The surface point a ray hit, interpolated from the triangle's vertices as
@@ -280,7 +369,7 @@ SurfacePoint surface_at_hit(const Mesh& mesh, const PixelHit& hit, const Camera&
     const glm::vec2 bx = plane_uv(glm::vec2(px) + glm::vec2(1.0f, 0.0f)), by = plane_uv(glm::vec2(px) + glm::vec2(0.0f, 1.0f));
     sp.duv_dx = lerp3(mesh.uvs, bx.x, bx.y, glm::vec2(0.0f)) - sp.uv;
     sp.duv_dy = lerp3(mesh.uvs, by.x, by.y, glm::vec2(0.0f)) - sp.uv;
-    sp.front_facing = glm::dot(glm::cross(e1, e2), hit.dir) < 0.0f;
+    sp.front_facing = hit.front_facing;
     return sp;
 }
 
@@ -316,7 +405,8 @@ void print_pixel_ibl(SceneRenderer& sr, const FrameSettings& settings, const Mes
 }
 
 void print_pixel(const Scene& scene, const Camera& cam, const Framebuffer& fb, const std::uint8_t* rgba8,
-                 glm::ivec2 px, int frame, SceneRenderer& sr, const FrameSettings& settings, int ibl_samples) {
+                 glm::ivec2 px, int frame, SceneRenderer& sr, const FrameSettings& settings, int ibl_samples,
+                 const PixelWinner& winner) {
     const float* c = fb.pixel(px.x, px.y);
     const float depth = fb.depth[std::size_t(px.y) * std::size_t(fb.width) + std::size_t(px.x)];
     std::printf("pixel %d,%d frame %d: depth %.6f linear %.6g %.6g %.6g", px.x, px.y, frame, double(depth),
@@ -325,18 +415,20 @@ void print_pixel(const Scene& scene, const Camera& cam, const Framebuffer& fb, c
         const std::uint8_t* s = &rgba8[(std::size_t(px.y) * std::size_t(fb.width) + std::size_t(px.x)) * 4];
         std::printf(" srgb8 %d %d %d", s[0], s[1], s[2]);
     }
-    if (depth >= 1.0f) {
-        std::printf(" (background)\n");
-        return;
-    }
-    const PixelHit hit = cast_pixel_ray(scene, cam, fb.width, fb.height, px);
-    if (hit.mesh < 0) {
-        std::printf(" (ray cast found no triangle)\n");
+    PixelHit hit = winner.winner();
+    if (hit.draw < 0) {
+        // Lines and points are not followed past their vertices (observer.h).
+        std::printf(depth >= 1.0f ? " (background)\n" : " (no triangle wrote it: a line or point did; step explains it)\n");
         return;
     }
     const Mesh& mesh = scene.meshes[std::size_t(hit.mesh)];
-    std::printf(" mesh %d '%s' triangle %zu material '%s'\n", hit.mesh, printable(mesh.name).c_str(), hit.triangle,
-                printable(scene.materials[std::size_t(std::max(0, mesh.material))].name).c_str());
+    // The name step prints (stepper/explain.h triangle_name()).
+    std::printf(" draw %d (mesh '%s') triangle %zu (frame triangle %u) material '%s', %s face", hit.draw,
+                printable(mesh.name).c_str(), hit.triangle, hit.frame_triangle,
+                printable(sr.material_of(mesh).m->name).c_str(), hit.front_facing ? "front" : "back");
+    if (settings.samples > 1) std::printf(", %d of %d samples", hit.samples, settings.samples);
+    std::printf("\n");
+    ray_on_triangle(mesh, cam, fb.width, fb.height, px, hit);
     if (sr.environment(settings)) print_pixel_ibl(sr, settings, mesh, hit, fb.width, fb.height, px, ibl_samples);
 }
 
@@ -507,6 +599,7 @@ int run(int argc, char** argv) {
     out8.raw = debug_view_is_data(opt.view);
     out8.keep_framebuffer = opt.pixel.has_value();  // --pixel reads the linear colour and depth
     std::vector<double> frame_ms;
+    std::optional<PixelWinner> winner;  // --pixel: the fragment that wrote it
     int step = 2;
     for (int index = opt.first_frame; index <= opt.last_frame; ++index) {
         // Frame i of a turntable sits at angle i * DEG / N around the target;
@@ -521,7 +614,14 @@ int run(int argc, char** argv) {
             progress.begin(step++, "frame " + std::to_string(index));
             g_stage = "rendering frame " + std::to_string(index);
             auto t0 = Clock::now();
-            scene_renderer.render(settings, fb, opt.hdr_output() ? nullptr : &out8);
+            if (opt.pixel) {
+                // The same frame, watched at the pixel for the fragment that wrote it.
+                winner.emplace(opt.pixel->x, opt.pixel->y, settings.samples, settings.visibility);
+                scene_renderer.render(settings, fb, opt.hdr_output() ? nullptr : &out8,
+                                      [&](const SceneDraw& d) { return winner->tap(d); });
+            } else {
+                scene_renderer.render(settings, fb, opt.hdr_output() ? nullptr : &out8);
+            }
             render_ms = ms_since(t0);
             frame_ms.push_back(render_ms);
         }
@@ -542,7 +642,7 @@ int run(int argc, char** argv) {
         }
         if (opt.pixel)
             print_pixel(scene, settings.camera, fb, rgba8, *opt.pixel, index, scene_renderer, settings,
-                        opt.samples_given ? opt.ibl_samples : 4096);
+                        opt.samples_given ? opt.ibl_samples : 4096, *winner);
         std::fflush(stdout);
     }
     progress.finish();

@@ -38,6 +38,30 @@ namespace {
 // Names come from the model: escaped, so they cannot drive the terminal.
 std::string quoted(const std::string& s) { return "'" + printable(s) + "'"; }
 
+} // namespace
+
+std::string triangle_name(const FrameSetup& s, const Recording& rec, std::uint32_t tri) {
+    const DrawRecord& d = rec.draw_of(tri);
+    return "draw " + std::to_string(rec.draw_index(tri)) + " (mesh " + quoted(s.scene.meshes[std::size_t(d.mesh)].name) +
+           ") triangle " + std::to_string(tri - d.first_triangle) + " (frame triangle " + std::to_string(tri) + ")";
+}
+
+std::string line_name(const FrameSetup& s, const Recording& rec, std::size_t draw, std::uint32_t prim) {
+    const DrawRecord& d = rec.draws[draw];
+    return "draw " + std::to_string(draw) + " (mesh " + quoted(s.scene.meshes[std::size_t(d.mesh)].name) + ") " +
+           (d.topology == Topology::Points ? "point " : "line ") + std::to_string(prim);
+}
+
+bool frame_triangle(const Recording& rec, long draw, long prim, std::uint32_t& tri) {
+    if (draw < 0 || std::size_t(draw) >= rec.draws.size() || prim < 0) return false;
+    const DrawRecord& d = rec.draws[std::size_t(draw)];
+    if (d.topology != Topology::Triangles || std::uint64_t(prim) >= d.triangle_count) return false;
+    tri = d.first_triangle + std::uint32_t(prim);
+    return true;
+}
+
+namespace {
+
 json j3(const glm::vec3& v) { return json::array({v.x, v.y, v.z}); }
 
 std::string plane_names(std::uint32_t planes) {
@@ -91,31 +115,70 @@ std::string level_footprint(const Texture& tex, glm::vec2 uv, int level) {
     return s;
 }
 
-// One map: its size, the level of detail, the levels and texels blended, the value.
-std::string map_text(const char* name, const Texture* tex, glm::vec2 uv, float lambda, const char* indent) {
+const char* filter_name(Filter f) { return f == Filter::Nearest ? "NEAREST" : "LINEAR"; }
+
+const char* min_filter_name(MinFilter f) {
+    switch (f) {
+    case MinFilter::Nearest: return "NEAREST";
+    case MinFilter::Linear: return "LINEAR";
+    case MinFilter::NearestMipmapNearest: return "NEAREST_MIPMAP_NEAREST";
+    case MinFilter::LinearMipmapNearest: return "LINEAR_MIPMAP_NEAREST";
+    case MinFilter::NearestMipmapLinear: return "NEAREST_MIPMAP_LINEAR";
+    case MinFilter::LinearMipmapLinear: break;
+    }
+    return "LINEAR_MIPMAP_LINEAR";
+}
+
+// "sampler: mag LINEAR, min LINEAR_MIPMAP_LINEAR, wrap repeat/repeat"
+std::string sampler_text(const Texture& tex) {
+    const SamplerState& st = tex.sampler();
+    return std::string("sampler: mag ") + filter_name(st.mag) + ", min " + min_filter_name(st.min) + ", wrap " +
+           wrap_name(st.wrap_s) + "/" + wrap_name(st.wrap_t);
+}
+
+// The NEAREST texel of one level: floor(u w), floor(v h), wrapped.
+std::string nearest_footprint(const Texture& tex, glm::vec2 uv, int level) {
+    const int w = tex.width(level), h = tex.height(level);
+    const int x = int(std::floor(reduce_wrap(tex.wrap_s(), uv.x) * float(w)));
+    const int y = int(std::floor(reduce_wrap(tex.wrap_t(), uv.y) * float(h)));
+    const int xi = wrap_texel(tex.wrap_s(), x, w), yi = wrap_texel(tex.wrap_t(), y, h);
+    return "level " + std::to_string(level) + " (" + std::to_string(w) + "x" + std::to_string(h) + "): nearest texel x " +
+           std::to_string(xi) + " y " + std::to_string(yi) + ": " + vec(tex.texel(level, xi, yi));
+}
+
+// One map: its size, UV set, sampler, the level of detail, the levels and
+// texels the sampler's filters read (Texture::choose_level), the value.
+std::string map_text(const char* name, const Texture* tex, int uv_set, glm::vec2 uv, float lambda,
+                     const char* indent) {
     if (!tex) return "";
     std::string s = std::string(indent) + "map " + name + ": " + std::to_string(tex->width(0)) + "x" +
-                    std::to_string(tex->height(0)) + ", " + std::to_string(tex->levels()) + " levels, wrap " +
-                    wrap_name(tex->wrap_s()) + "/" + wrap_name(tex->wrap_t()) + ", lambda " + num(lambda);
+                    std::to_string(tex->height(0)) + ", " + std::to_string(tex->levels()) + " levels, UV set " +
+                    std::to_string(uv_set) + " " + vec(uv) + ", " + sampler_text(*tex) + ", lambda " + num(lambda);
+    const LevelChoice c = tex->choose_level(lambda);
+    const SamplerState& st = tex->sampler();
+    const char* filter = c.nearest ? "nearest" : "bilinear";
     const int last = tex->levels() - 1;
-    std::vector<int> levels;
-    if (!(lambda > 0.0f)) {
-        s += " (magnification: bilinear on level 0)";
-        levels = {0};
-    } else if (lambda >= float(last)) {
-        s += " (past the last level: bilinear on level " + std::to_string(last) + ")";
-        levels = {last};
+    // OpenGL's switch-over point (texture.h): 0.5 for LINEAR magnification
+    // with NEAREST_MIPMAP_* minification, else 0.
+    const float switch_c = st.mag == Filter::Linear && (st.min == MinFilter::NearestMipmapNearest ||
+                                                        st.min == MinFilter::NearestMipmapLinear) ? 0.5f : 0.0f;
+    const bool mipmap_linear = st.min == MinFilter::LinearMipmapLinear || st.min == MinFilter::NearestMipmapLinear;
+    std::vector<int> levels = {c.level};
+    if (!(lambda > switch_c)) {
+        s += std::string(" (magnification: ") + filter + " on level 0)";
+    } else if (mipmap_linear && lambda >= float(last)) {
+        s += std::string(" (past the last level: ") + filter + " on level " + std::to_string(last) + ")";
+    } else if (mipmap_linear) {
+        s += std::string(" (") + (c.nearest ? "nearest, mipmap linear" : "trilinear") + ": levels " +
+             std::to_string(c.level) + " and " + std::to_string(c.level + 1) + ", blend " + num(c.t) + ")";
+        if (c.blend) levels.push_back(c.level + 1);
     } else {
-        const float fl = std::floor(lambda);
-        const float t = lambda - fl;
-        s += " (trilinear: levels " + std::to_string(int(fl)) + " and " + std::to_string(int(fl) + 1) +
-             ", blend " + num(t) + ")";
-        levels = {int(fl)};
-        if (t != 0.0f) levels.push_back(int(fl) + 1);
+        s += std::string(" (") + filter + " on level " + std::to_string(c.level) + ")";
     }
     s += "\n";
-    for (int L : levels) s += std::string(indent) + "  " + level_footprint(*tex, uv, L) + "\n";
-    s += std::string(indent) + "  sample " + vec(tex->sample_trilinear(uv.x, uv.y, lambda)) + "\n";
+    for (int L : levels)
+        s += std::string(indent) + "  " + (c.nearest ? nearest_footprint(*tex, uv, L) : level_footprint(*tex, uv, L)) + "\n";
+    s += std::string(indent) + "  sample " + vec(tex->sample_lod(uv.x, uv.y, lambda)) + "\n";
     return s;
 }
 
@@ -233,8 +296,41 @@ std::string frame_text(const FrameSetup& s, const Recording& rec) {
         o << "light " << i << ": " << (L.point ? "point at " + vec(L.position) : "sun towards " + vec(L.direction))
           << " radiance " << vec(L.radiance) << "\n";
     }
-    o << "ambient " << vec(s.settings.ambient) << ", brdf " << brdf_model_name(s.settings.model) << ", exposure "
-      << num(s.exposure()) << ", tone map " << tonemap_name(s.tonemap()) << "\n";
+    // What lights the frame besides the lights: an environment (then the
+    // ambient term is not used) or the ambient colour.
+    const Environment* env = s.scene_renderer->environment(s.settings);
+    if (env) {
+        const std::string source = !s.request.env.empty() ? "file " + quoted(s.request.env)
+                                   : s.request.scene.empty() ? std::string("built-in sky")
+                                                             : std::string("the scene's own");
+        o << "environment " << source << ", " << env->width() << "x" << env->height() << ", intensity "
+          << num(s.request.env_intensity) << ", rotated " << num(s.request.env_rotate_deg)
+          << " degrees: split sum (SH irradiance, " << Environment::kSpecularLevels
+          << " GGX-prefiltered levels, a DFG table) in place of the ambient term\n";
+        o << "brdf ";
+    } else {
+        o << "ambient " << vec(s.settings.ambient) << ", brdf ";
+    }
+    o << brdf_model_name(s.settings.model) << ", exposure " << num(s.exposure()) << ", tone map "
+      << tonemap_name(s.tonemap()) << "\n";
+    // Shadows: which lights cast, through which maps (shading/shadow/).
+    if (!s.settings.shadows.enabled) {
+        o << "shadows off\n";
+    } else {
+        const ShadingContext ctx = s.shading_context();
+        o << "shadows on:";
+        bool any = false;
+        for (std::size_t i = 0; i < ctx.lights.size(); ++i) {
+            const ShadowMap* m = ctx.lights[i].shadow;
+            if (!m) continue;
+            o << (any ? ";" : "") << " light " << i << " "
+              << (m->cube ? "cube map, 6 faces of " : "directional map ") << m->size << "x" << m->size;
+            any = true;
+        }
+        if (!any) o << " no light has a map (nothing casts)";
+        o << "; bias " << num(kShadowConstantBias) << " + " << num(kShadowSlopeBias)
+          << " tan(theta) texels, PCF 3x3 bilinear taps\n";
+    }
     // The counters, without the times (those are for `cost`).
     std::istringstream stats(rec.stats.to_string());
     for (std::string l; std::getline(stats, l);)
@@ -273,9 +369,10 @@ std::string triangle_text(const FrameSetup& s, const Recording& rec, std::uint32
     const DrawRecord& d = rec.draw_of(tri);
     const TriangleRecord& tr = rec.triangles[tri];
     const BoundMaterial& bm = material_of(s, rec, tri);
-    o << "tri " << tri << ": draw " << (&d - rec.draws.data()) << " mesh " << d.mesh << " "
-      << quoted(mesh_name(s, rec, tri)) << " prim " << (tri - d.first_triangle) << " of " << d.triangle_count
-      << ", material " << quoted(bm.m->name) << ", cull " << (d.state.cull == CullMode::Back ? "back" : "none")
+    o << "tri " << tri << ": " << triangle_name(s, rec, tri) << ", " << d.triangle_count << " in the draw, mesh "
+      << d.mesh << ", material " << quoted(bm.m->name) << ", cull " << (d.state.cull == CullMode::Back ? "back" : "none")
+      << (d.varyings == kPbrVaryingsExt ? ", " + std::to_string(d.varyings) + " varyings (vertex colours or UV set 1)"
+                                        : std::string())
       << "\n";
     if (!tr.seen) {
         o << "  not submitted\n";
@@ -482,27 +579,8 @@ PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x,
     int pending[kMaxSamples];
     for (int i = 0; i < S; ++i) pending[i] = -1;
     int blends = 0;
-    for (const BlockRecord& b : tile.blocks) {
-        if (b.bx != bx || b.by != by || !(b.mask & (1u << lane))) continue;
-        HistoryEntry h;
-        h.piece = b.piece;
-        h.lane = lane;
-        h.block = &b;
-        const std::uint32_t tri = rec.pieces[b.piece].triangle;
-        const DrawRecord& d = rec.draw_of(tri);
-        h.visible = d.visible;
-        for (int i = 0; i < S; ++i) {
-            if (!((rec.cover(tile, b, i) >> lane) & 1u)) continue;
-            h.cover |= 1u << i;
-            h.z[i] = rec.depth(tile, b, i, lane);
-            h.depth_before[i] = px.sample_depth[i];
-            if ((rec.pass(tile, b, i) >> lane) & 1u) h.pass |= 1u << i;
-        }
-        h.shaded = (b.shaded >> lane) & 1u;
-        h.written = (b.live >> lane) & 1u;
-        h.killed = h.shaded && !h.written;
-        replay_block(s, rec, b, h.replay);
-        if (h.shaded) h.shading = shade_lane(ctx, material_of(s, rec, tri), h.replay, lane);
+    // A fragment's effect on the samples, once its tests and shading are known.
+    auto account = [&](HistoryEntry& h, const DrawRecord& d) {
         const int index = int(px.history.size());
         const bool blend = d.state.blend == Blend::Alpha && h.written && h.pass;
         if (blend) {
@@ -540,7 +618,70 @@ PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x,
             }
         }
         px.history.push_back(std::move(h));
+    };
+    // The lines and points of draw `di` covering the pixel, in order
+    // (line_raster.h: every sample covered at the pixel's depth, always
+    // shaded in order).
+    auto line_draw = [&](std::size_t di) {
+        const DrawRecord& d = rec.draws[di];
+        for (std::uint32_t prim = 0; prim < d.primitives; ++prim) {
+            const LineReplay l = replay_line(s, rec, di, prim);
+            if (!l.drawn || !line_covers(l.setup, x, y)) continue;
+            HistoryEntry h;
+            h.line_draw = int(di);
+            h.line_prim = prim;
+            h.line = l;
+            h.lane = lane;
+            LineFragment f;
+            replay_line_fragment(s, rec, di, l, x, y, f);
+            h.line_t = f.t;
+            h.line_w1 = f.w1;
+            h.replay = f.block;
+            for (int i = 0; i < S; ++i) {
+                h.cover |= 1u << i;
+                h.z[i] = f.z;
+                h.depth_before[i] = px.sample_depth[i];
+                if (!d.state.depth_test || f.z < px.sample_depth[i]) h.pass |= 1u << i;
+            }
+            if (h.pass) {
+                h.shaded = true;
+                h.shading = shade_lane(ctx, draw_material(s, d), h.replay, lane);
+                h.killed = h.shading.killed;
+                h.written = !h.killed;
+            }
+            account(h, d);
+        }
+    };
+    std::size_t next_draw = 0;  // line draws before it are done
+    auto lines_before = [&](std::size_t di) {
+        for (; next_draw < di && next_draw < rec.draws.size(); ++next_draw)
+            if (rec.draws[next_draw].topology != Topology::Triangles) line_draw(next_draw);
+    };
+    for (const BlockRecord& b : tile.blocks) {
+        if (b.bx != bx || b.by != by || !(b.mask & (1u << lane))) continue;
+        HistoryEntry h;
+        h.piece = b.piece;
+        h.lane = lane;
+        h.block = &b;
+        const std::uint32_t tri = rec.pieces[b.piece].triangle;
+        const DrawRecord& d = rec.draw_of(tri);
+        lines_before(rec.draw_index(tri));
+        h.visible = d.visible;
+        for (int i = 0; i < S; ++i) {
+            if (!((rec.cover(tile, b, i) >> lane) & 1u)) continue;
+            h.cover |= 1u << i;
+            h.z[i] = rec.depth(tile, b, i, lane);
+            h.depth_before[i] = px.sample_depth[i];
+            if ((rec.pass(tile, b, i) >> lane) & 1u) h.pass |= 1u << i;
+        }
+        h.shaded = (b.shaded >> lane) & 1u;
+        h.written = (b.live >> lane) & 1u;
+        h.killed = h.shaded && !h.written;
+        replay_block(s, rec, b, h.replay);
+        if (h.shaded) h.shading = shade_lane(ctx, material_of(s, rec, tri), h.replay, lane);
+        account(h, d);
     }
+    lines_before(rec.draws.size());
     // The visibility pass's winners, shaded once per pixel: their colour.
     for (int i = 0; i < S; ++i) {
         if (pending[i] < 0) continue;
@@ -570,16 +711,50 @@ PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x,
 
 namespace {
 
+// "base colour = factor (..) x texture(UV set n, sampler: ...) (..) x vertex colour (..) = (..)"
+std::string base_colour_text(const BoundMaterial& bm, const glm::vec4& texture, bool has_color, const glm::vec4& color,
+                             const glm::vec4& result) {
+    std::string t = "base colour = factor " + vec(bm.m->base_color_factor);
+    if (bm.base_color)
+        t += " x texture(UV set " + std::to_string(int(bm.uv.base_color)) + ", " + sampler_text(*bm.base_color) +
+             ") " + vec(texture);
+    if (has_color) t += " x vertex colour " + vec(color);
+    return t + " = " + vec(result);
+}
+
 void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& rec, const HistoryEntry& h) {
-    const std::uint32_t tri = rec.pieces[h.piece].triangle;
-    const BoundMaterial& bm = material_of(s, rec, tri);
+    const BoundMaterial& bm = h.line_draw >= 0 ? draw_material(s, rec.draws[std::size_t(h.line_draw)])
+                                               : material_of(s, rec, rec.pieces[h.piece].triangle);
     const Material& m = *bm.m;
     const LaneShading& sh = h.shading;
     const MaterialSample& ms = sh.ms;
     const SurfacePoint& sp = sh.sp;
+    if (sh.unlit) {
+        // UnlitProgram (renderer/scene_renderer.h): no lights, no environment.
+        o << "  unlit (a line or point without normals, drawn as glTF asks): zero derivatives, textures read "
+             "their finest level\n";
+        o << "  uv " << vec(sp.uv) << " (UV set " << int(bm.uv.base_color) << ")\n";
+        o << "  vertex colour " << vec(sh.unlit_color) << (s.scene.meshes[std::size_t(rec.draws[std::size_t(h.line_draw)].mesh)].colors.empty()
+                                                                ? " (the mesh has none: white)" : " (COLOR_0, interpolated)")
+          << "\n";
+        o << map_text("base_color", bm.base_color, bm.uv.base_color, sp.uv, 0.0f, "  ");
+        o << "  " << base_colour_text(bm, sh.unlit_texture, true, sh.unlit_color,
+                                      m.base_color_factor * sh.unlit_color * sh.unlit_texture) << "\n";
+        o << "  alpha " << num(ms.alpha);
+        if (m.alpha_mode == AlphaMode::Mask) o << " (mask cutoff " << num(m.alpha_cutoff) << ")";
+        else if (m.alpha_mode == AlphaMode::Blend) o << " (the blend weight)";
+        o << "\n  shaded colour (unlit: the base colour's rgb) " << vec(sh.Lo) << "\n";
+        if (!sh.matches_shade_surface) o << "  NOTE: UnlitProgram::fragment() gives a different value\n";
+        return;
+    }
     o << "  geometric normal " << vec(ms.N_geom) << (sp.front_facing ? "" : " (back face: flipped)") << "\n";
     o << "  uv " << vec(sp.uv) << ", d(uv)/dx " << vec(sp.duv_dx) << ", d(uv)/dy " << vec(sp.duv_dy)
-      << " (per 2x2 quad)\n";
+      << (h.line_draw >= 0 ? " (a line or point: zero derivatives)" : " (per 2x2 quad)") << "\n";
+    if (h.replay.varyings == kPbrVaryingsExt)
+        for (int set = 1; set < kMaxUvSets; ++set)
+            o << "  uv set " << set << " " << vec(sp.uv_of(set)) << ", d/dx " << vec(sp.duv_dx_of(set)) << ", d/dy "
+              << vec(sp.duv_dy_of(set)) << "\n";
+    if (sp.has_color) o << "  vertex colour (COLOR_0, interpolated) " << vec(sp.color) << "\n";
     if (bm.normal) {
         const glm::vec3 N = glm::normalize(sp.N);
         glm::vec3 T = glm::vec3(sp.T);
@@ -591,18 +766,27 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
             const glm::vec3 B = glm::cross(N, T) * w;
             o << "  tangent T " << vec(T) << " (w " << num(w) << "), bitangent B = cross(N, T) w " << vec(B) << "\n";
         }
-        o << map_text("normal", bm.normal, sp.uv, sh.lods.normal, "  ");
-        const glm::vec4 tx = bm.normal->sample_trilinear(sp.uv.x, sp.uv.y, sh.lods.normal);
+        const glm::vec2 nuv = sp.uv_of(bm.uv.normal);
+        o << map_text("normal", bm.normal, bm.uv.normal, nuv, sh.lods.normal, "  ");
+        const glm::vec4 tx = bm.normal->sample_lod(nuv.x, nuv.y, sh.lods.normal);
         o << "  normal-map texel " << vec(glm::vec3(tx)) << " -> tangent space " << vec(glm::vec3(tx) * 2.0f - 1.0f)
           << " (scale " << num(m.normal_scale) << ")\n";
     }
     o << "  mapped normal n " << vec(ms.N) << "\n";
-    o << map_text("base_color", bm.base_color, sp.uv, sh.lods.base_color, "  ");
-    o << map_text("metallic_roughness", bm.metallic_roughness, sp.uv, sh.lods.metallic_roughness, "  ");
-    o << map_text("roughness", bm.roughness, sp.uv, sh.lods.roughness, "  ");
-    o << map_text("metallic", bm.metallic, sp.uv, sh.lods.metallic, "  ");
-    o << map_text("occlusion", bm.occlusion, sp.uv, sh.lods.occlusion, "  ");
-    o << map_text("emissive", bm.emissive, sp.uv, sh.lods.emissive, "  ");
+    auto map = [&](const char* name, const Texture* tex, int set, float lambda) {
+        o << map_text(name, tex, set, sp.uv_of(set), lambda, "  ");
+    };
+    map("base_color", bm.base_color, bm.uv.base_color, sh.lods.base_color);
+    map("metallic_roughness", bm.metallic_roughness, bm.uv.metallic_roughness, sh.lods.metallic_roughness);
+    map("roughness", bm.roughness, bm.uv.roughness, sh.lods.roughness);
+    map("metallic", bm.metallic, bm.uv.metallic, sh.lods.metallic);
+    map("occlusion", bm.occlusion, bm.uv.occlusion, sh.lods.occlusion);
+    map("emissive", bm.emissive, bm.uv.emissive, sh.lods.emissive);
+    if (bm.base_color || sp.has_color) {
+        const glm::vec2 buv = sp.uv_of(bm.uv.base_color);
+        const glm::vec4 tex = bm.base_color ? bm.base_color->sample_lod(buv.x, buv.y, sh.lods.base_color) : glm::vec4(1.0f);
+        o << "  " << base_colour_text(bm, tex, sp.has_color, sp.color, glm::vec4(ms.albedo, ms.alpha)) << "\n";
+    }
     const float r = glm::clamp(ms.roughness, kMinPerceptualRoughness, 1.0f);
     o << "  albedo " << vec(ms.albedo) << ", alpha " << num(ms.alpha);
     if (m.alpha_mode == AlphaMode::Mask) o << " (mask cutoff " << num(m.alpha_cutoff) << ")";
@@ -668,8 +852,60 @@ std::string sample_list(std::uint32_t bits, int samples) {
 }
 
 std::string entry_name(const Recording& rec, const PixelExplanation& px, int k) {
-    return "#" + std::to_string(k + 1) + " (tri " + std::to_string(rec.pieces[px.history[std::size_t(k)].piece].triangle) +
-           ")";
+    const HistoryEntry& h = px.history[std::size_t(k)];
+    if (h.line_draw >= 0)
+        return "#" + std::to_string(k + 1) + " (draw " + std::to_string(h.line_draw) +
+               (rec.draws[std::size_t(h.line_draw)].topology == Topology::Points ? " point " : " line ") +
+               std::to_string(h.line_prim) + ")";
+    return "#" + std::to_string(k + 1) + " (tri " + std::to_string(rec.pieces[h.piece].triangle) + ")";
+}
+
+// The history line of a line or point fragment and how line.h's rules gave it the pixel.
+void line_entry_text(std::ostringstream& o, const FrameSetup& s, const Recording& rec, const PixelExplanation& px,
+                     const HistoryEntry& h, std::size_t i) {
+    const DrawRecord& d = rec.draws[std::size_t(h.line_draw)];
+    const LineSetup& l = h.line.setup;
+    o << "  #" << i + 1 << " " << line_name(s, rec, std::size_t(h.line_draw), h.line_prim) << ", material "
+      << quoted(draw_material(s, d).m->name) << ", vertices " << h.line.index[0];
+    if (!l.point) o << " " << h.line.index[1];
+    o << (h.line.planes ? ", clipped against " + plane_names(h.line.planes) : std::string()) << "\n";
+    auto px_of = [](std::int32_t v) { return num(double(v) / 256.0); };
+    if (l.point) {
+        o << "     point fragment: at (" << px_of(l.x0) << ", " << px_of(l.y0) << ") px (fixed " << l.x0 << ", " << l.y0
+          << "), coverage rule: the pixel containing it, floor(x), floor(y) = " << px.x << " " << px.y
+          << " (a point on a pixel edge belongs to the pixel right of or below it)\n";
+    } else {
+        o << "     line fragment: segment from (" << px_of(l.x0) << ", " << px_of(l.y0) << ") to (" << px_of(l.x1)
+          << ", " << px_of(l.y1) << ") px (fixed " << l.x0 << "," << l.y0 << " -> " << l.x1 << "," << l.y1 << "), "
+          << (l.x_major ? "x" : "y") << "-major\n";
+        o << "     coverage rule (diamond exit): the segment meets the pixel's diamond |x - " << px.x << ".5| + |y - "
+          << px.y << ".5| < 1/2 and its end is not inside it (ties: the segment moved by (+e, +e^2))\n";
+        o << "     at t " << num(h.line_t) << " along it (the centre's projection): perspective weight of the end "
+          << num(h.line_w1) << "\n";
+    }
+    const int S = px.samples;
+    if (S > 1) o << "     covers all " << S << " samples (aliased: every sample at the pixel's depth)\n";
+    for (int k = 0; k < S; ++k) {
+        const bool passed = (h.pass >> k) & 1u;
+        const std::string test = d.state.depth_test ? (passed ? "passed" : "failed the depth test (LESS)") : "no depth test";
+        if (S == 1) o << "     depth " << num(h.z[k]) << " vs buffer " << num(h.depth_before[k]) << ": " << test << "\n";
+        else o << "     sample " << k << ": depth " << num(h.z[k]) << " vs " << num(h.depth_before[k]) << ": " << test << "\n";
+    }
+    if (!h.pass) o << "     hidden: the depth test failed\n";
+    else if (h.killed) o << "     shaded in order: discarded by the shader (alpha " << num(h.shading.ms.alpha)
+                         << " below the cutoff)\n";
+    else if (h.blend_order) {
+        o << "     shaded in order (alpha blend; depth tested, not written): blend #" << h.blend_order << ", shader out "
+          << vec(h.shading.Lo) << " alpha " << num(h.alpha) << "\n";
+        for (int k = 0; k < S; ++k)
+            if ((h.pass >> k) & 1u)
+                o << "     " << (S > 1 ? "sample " + std::to_string(k) + ": " : std::string())
+                  << "out * alpha + previous * (1 - alpha) = " << vec(h.blended[k]) << "\n";
+    } else {
+        o << "     shaded in order (lines and points always are): " << (h.shading.unlit ? "unlit, " : "")
+          << "shader out " << vec(h.shading.Lo) << ", written to sample" << (__builtin_popcount(h.pass) > 1 ? "s " : " ")
+          << sample_list(h.pass, S) << "\n";
+    }
 }
 
 } // namespace
@@ -691,16 +927,19 @@ std::string pixel_text(const FrameSetup& s, const Recording& rec, const PixelExp
       << (px.history.size() == 1 ? "" : "s") << " in submission order\n";
     for (std::size_t i = 0; i < px.history.size(); ++i) {
         const HistoryEntry& h = px.history[i];
+        if (h.line_draw >= 0) {
+            line_entry_text(o, s, rec, px, h, i);
+            continue;
+        }
         const PieceRecord& p = rec.pieces[h.piece];
         const TriangleRecord& tr = rec.triangles[p.triangle];
         const DrawRecord& d = rec.draw_of(p.triangle);
         const TriangleSetup& t = rec.setups[p.setup];
-        const SurfacePoint sp = PbrProgram::surface_point(h.replay.in, h.lane);
-        o << "  #" << i + 1 << " tri " << p.triangle;
+        const SurfacePoint sp = replay_surface_point(h.replay, h.lane);
+        o << "  #" << i + 1 << " " << triangle_name(s, rec, p.triangle);
         if (tr.piece_count > 1) o << " piece " << (h.piece - tr.first_piece);
-        o << " (draw " << (&d - rec.draws.data()) << " " << quoted(mesh_name(s, rec, p.triangle)) << " prim "
-          << (p.triangle - d.first_triangle) << ", material " << quoted(material_of(s, rec, p.triangle).m->name)
-          << ", " << (t.front_facing ? "front" : "back") << " face)\n";
+        o << ", material " << quoted(material_of(s, rec, p.triangle).m->name) << ", "
+          << (t.front_facing ? "front" : "back") << " face\n";
         const int l = h.lane;
         if (S > 1) o << "     covers samples " << sample_list(h.cover, S) << " of " << S << "\n";
         o << "     barycentrics screen (" << num(h.replay.bary[0][l]) << ", " << num(h.replay.bary[1][l]) << ", "
@@ -710,7 +949,11 @@ std::string pixel_text(const FrameSetup& s, const Recording& rec, const PixelExp
             o << " at the centroid of samples " << sample_list(h.replay.centroid_of[l], S) << " ("
               << num(h.replay.at_x[l]) << ", " << num(h.replay.at_y[l]) << ") px: the centre is outside";
         o << "\n";
-        o << "     P " << vec(sp.P) << " N " << vec(sp.N) << " uv " << vec(sp.uv) << " T " << vec(sp.T) << "\n";
+        o << "     P " << vec(sp.P) << " N " << vec(sp.N) << " uv " << vec(sp.uv) << " T " << vec(sp.T);
+        if (h.replay.varyings == kPbrVaryingsExt)
+            for (int set = 1; set < kMaxUvSets; ++set) o << " uv" << set << " " << vec(sp.uv_of(set));
+        if (sp.has_color) o << " colour " << vec(sp.color);
+        o << "\n";
         bool consistent = true;
         for (int k = 0; k < S; ++k) {
             if (!((h.cover >> k) & 1u)) continue;
@@ -790,8 +1033,17 @@ json pixel_json(const FrameSetup& s, const Recording& rec, const PixelExplanatio
     json hist = json::array();
     for (const HistoryEntry& h : px.history) {
         json e;
-        e["tri"] = rec.pieces[h.piece].triangle;
-        e["mesh"] = mesh_name(s, rec, rec.pieces[h.piece].triangle);
+        if (h.line_draw >= 0) {
+            const DrawRecord& d = rec.draws[std::size_t(h.line_draw)];
+            e["draw"] = h.line_draw;
+            e[d.topology == Topology::Points ? "point" : "line"] = h.line_prim;
+            e["mesh"] = s.scene.meshes[std::size_t(d.mesh)].name;
+        } else {
+            const std::uint32_t tri = rec.pieces[h.piece].triangle;
+            e["tri"] = tri;
+            e["draw"] = rec.draw_index(tri);
+            e["mesh"] = mesh_name(s, rec, tri);
+        }
         e["depth"] = h.z[__builtin_ctz(h.cover)];
         e["cover"] = sample_list(h.cover, px.samples);
         e["pass"] = sample_list(h.pass, px.samples);

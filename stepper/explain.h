@@ -31,9 +31,14 @@ struct TileWalk {
 TileWalk walk_tile(const Recording& rec, std::uint32_t piece, int tile);
 
 // One fragment of a pixel's history: a triangle piece covering at least one
-// of the pixel's samples, in the order the tile ran it.
+// of the pixel's samples, or a line or point covering the pixel, in the order
+// the tile ran it.
 struct HistoryEntry {
-    std::uint32_t piece = 0;
+    std::uint32_t piece = 0;      // triangles: the piece (line_draw < 0)
+    int line_draw = -1;           // a line or point fragment: its draw (piece and block unused)
+    std::uint32_t line_prim = 0;  // ... the line's or point's number in its draw
+    LineReplay line;              // ... as set up (clipped ends, fixed-point setup)
+    float line_t = 0.0f, line_w1 = 0.0f;  // ... the centre's parameter on the segment, P1's perspective weight
     int lane = 0;
     const BlockRecord* block = nullptr;
     bool visible = false;         // its draw took the visibility pass (else shaded in order)
@@ -83,5 +88,14 @@ nlohmann::json pixel_json(const FrameSetup& s, const Recording& rec, const Pixel
 
 const char* fate_name(TriangleFate f);
 std::string mesh_name(const FrameSetup& s, const Recording& rec, std::uint32_t tri);
+
+// The one name of a triangle both `render --pixel` and `step` print:
+// "draw D (mesh 'NAME') triangle P (frame triangle N)", P within the draw's
+// mesh, N over the frame in submission order (what `tri N` takes).
+std::string triangle_name(const FrameSetup& s, const Recording& rec, std::uint32_t tri);
+// A line or point: "draw D (mesh 'NAME') line P" (or point P).
+std::string line_name(const FrameSetup& s, const Recording& rec, std::size_t draw, std::uint32_t prim);
+// The frame triangle that "draw D ... triangle P" names; false when there is none.
+bool frame_triangle(const Recording& rec, long draw, long prim, std::uint32_t& tri);
 
 } // namespace prast::stepper

@@ -16,9 +16,25 @@ const DrawRecord& Recording::draw_of(std::uint32_t tri) const {
     return *(it == draws.begin() ? it : it - 1);
 }
 
+void DrawRecord::full_vertex(std::uint32_t v, float* out) const {
+    std::memcpy(out, &vertices[std::size_t(v) * kStride], sizeof(float) * std::size_t(std::min(kStride, stride())));
+    const int m = more_count();
+    if (m) std::memcpy(out + kStride, &more[std::size_t(v) * std::size_t(m)], sizeof(float) * std::size_t(m));
+}
+
+int draw_varyings(const FrameSetup& s, const SceneDraw& d) {
+    const Mesh& mesh = s.scene.meshes[std::size_t(d.mesh)];
+    const BoundMaterial& bm = s.scene_renderer->material_of(mesh);
+    const DebugView view = s.settings.view;
+    if (mesh.topology != Mesh::Topology::Triangles && mesh.normals.empty() &&
+        (view == DebugView::None || view == DebugView::Tiles))
+        return UnlitProgram::kVaryings;
+    return needs_extended_varyings(mesh, bm) ? kPbrVaryingsExt : kPbrVaryings;
+}
+
 std::size_t Recording::bytes() const {
     std::size_t n = sizeof(Recording);
-    for (const DrawRecord& d : draws) n += sizeof d + d.vertices.size() * sizeof(float);
+    for (const DrawRecord& d : draws) n += sizeof d + (d.vertices.size() + d.more.size()) * sizeof(float);
     n += triangles.size() * sizeof(TriangleRecord) + pieces.size() * sizeof(PieceRecord) +
          setups.size() * sizeof(TriangleSetup) + piece_tiles.size() * sizeof(std::uint32_t);
     for (const TileRecord& t : tiles)
@@ -68,15 +84,20 @@ public:
     };
 
     // A new draw (before the pipeline runs it): its record and its tap.
-    Tap tap(int mesh, std::uint32_t first, std::uint32_t triangles, std::uint32_t vertices, const DrawState& st) {
+    Tap tap(int mesh, std::uint32_t first, std::uint32_t triangles, std::uint32_t vertices, const DrawState& st,
+            int varyings, std::uint32_t primitives) {
         DrawRecord d;
         d.mesh = mesh;
+        d.varyings = varyings;
+        d.topology = st.topology;
+        d.primitives = primitives;
         d.state = st;
         d.visible = shades_after_visibility(st, rec_.visibility);
         d.first_triangle = first;
         d.triangle_count = triangles;
         d.vertex_count = vertices;
         d.vertices.assign(std::size_t(vertices) * kStride, 0.0f);
+        d.more.assign(std::size_t(vertices) * std::size_t(d.more_count()), 0.0f);
         rec_.draws.push_back(std::move(d));
         auto ev = std::make_unique<DrawEvents>();
         ev->seq.assign(triangles, 0);
@@ -100,9 +121,17 @@ private:
     };
 
     void vertex(std::size_t draw, std::uint32_t v, const float* clip, const float* var, int nv) {
-        float* d = &rec_.draws[draw].vertices[std::size_t(v) * kStride];
+        DrawRecord& dr = rec_.draws[draw];
+        if (nv != dr.varyings) {
+            std::lock_guard<std::mutex> lock(mismatch_mutex_);
+            ++rec_.layout_mismatches;
+            return;
+        }
+        float* d = &dr.vertices[std::size_t(v) * kStride];
         std::memcpy(d, clip, 4 * sizeof(float));
         std::memcpy(d + 4, var, std::size_t(std::min(nv, int(kPbrVaryings))) * sizeof(float));
+        const int m = dr.more_count();
+        if (m) std::memcpy(&dr.more[std::size_t(v) * std::size_t(m)], var + kPbrVaryings, std::size_t(m) * sizeof(float));
     }
 
     void triangle(std::size_t draw, std::uint32_t prim, TriangleFate fate, bool clipped, const TriangleSetup* t) {
@@ -172,6 +201,7 @@ private:
 
     Recording& rec_;
     std::vector<std::unique_ptr<DrawEvents>> events_;  // per draw
+    std::mutex mismatch_mutex_;
 };
 
 void RecordingObserver::finish() {
@@ -278,7 +308,11 @@ void record_frame(FrameSetup& s, Recording& rec) {
     RecordingObserver obs(rec);
     const auto t0 = std::chrono::steady_clock::now();
     s.scene_renderer->render(s.settings, rec.fb, nullptr, [&](const SceneDraw& d) {
-        return obs.tap(d.mesh, d.first_triangle, d.triangle_count, d.vertex_count, d.state);
+        const Mesh& mesh = s.scene.meshes[std::size_t(d.mesh)];
+        const std::size_t n = mesh.indices.size();
+        const std::uint32_t prims = d.state.topology == Topology::Lines ? std::uint32_t(n / 2)
+                                    : d.state.topology == Topology::Points ? std::uint32_t(n) : 0;
+        return obs.tap(d.mesh, d.first_triangle, d.triangle_count, d.vertex_count, d.state, draw_varyings(s, d), prims);
     });
     obs.finish();
     rec.record_ms = ms_since(t0);

@@ -32,7 +32,15 @@
 
 namespace prast::stepper {
 
-constexpr int kStride = 4 + kPbrVaryings;  // floats per vertex: clip xyzw, varyings
+// A vertex as the recording keeps it: clip xyzw and the first kPbrVaryings
+// varyings in DrawRecord::vertices (kStride floats, the layout every draw
+// shares); a draw whose program writes more (PbrProgramExt) keeps the rest
+// in DrawRecord::more, so the common narrow draws pay nothing for the wide
+// ones. A program with fewer (UnlitProgram) leaves the tail of its kStride
+// zero. full_vertex() puts a vertex back together (kMaxStride floats).
+constexpr int kStride = 4 + kPbrVaryings;
+constexpr int kMaxVaryingsRecorded = kPbrVaryingsExt;
+constexpr int kMaxStride = 4 + kMaxVaryingsRecorded;
 constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 
 struct DrawRecord {
@@ -42,7 +50,15 @@ struct DrawRecord {
     std::uint32_t first_triangle = 0;   // global number of the draw's triangle 0
     std::uint32_t triangle_count = 0;
     std::uint32_t vertex_count = 0;
+    int varyings = kPbrVaryings;        // floats the draw's program writes after clip xyzw
+    Topology topology = Topology::Triangles;
+    std::uint32_t primitives = 0;       // lines or points: how many the draw submits
     std::vector<float> vertices;        // kStride floats per vertex, as the vertex stage wrote them
+    std::vector<float> more;            // varyings past kPbrVaryings: (varyings - kPbrVaryings) per vertex
+    int stride() const { return 4 + varyings; }
+    int more_count() const { return varyings > kPbrVaryings ? varyings - kPbrVaryings : 0; }
+    // Vertex v as the vertex stage wrote it: stride() floats into out.
+    void full_vertex(std::uint32_t v, float* out) const;
 };
 
 // A post-clip piece of a triangle (an unclipped triangle is one piece).
@@ -96,8 +112,12 @@ struct Recording {
     double record_ms = 0.0;                 // wall time of the recorded frame
 
     int tile_of(int x, int y) const { return (y / tile_size) * tiles_x + x / tile_size; }
-    // Which draw holds global triangle `tri`.
+    // Which draw holds global triangle `tri` (draws of lines and points hold none).
     const DrawRecord& draw_of(std::uint32_t tri) const;
+    std::size_t draw_index(std::uint32_t tri) const { return std::size_t(&draw_of(tri) - draws.data()); }
+    // Vertex recording mismatches (a program wrote another varying count
+    // than the one the recording laid out for it): 0, or the stepper is wrong.
+    std::uint32_t layout_mismatches = 0;
     std::uint32_t triangle_count() const { return std::uint32_t(triangles.size()); }
     std::size_t bytes() const;              // memory held, without the framebuffer
 
@@ -115,6 +135,11 @@ struct Recording {
         return t.z[k + std::size_t(__builtin_popcount(cover(t, b, s) & ((1u << lane) - 1u)))];
     }
 };
+
+// The varyings the program of a draw writes (renderer/scene_renderer.h's
+// choice: UnlitProgram for lines and points without normals in the lit
+// image, PbrProgramExt for vertex colours or a second UV set, else PbrProgram).
+int draw_varyings(const FrameSetup& s, const SceneDraw& d);
 
 // Draws the frame (SceneRenderer::render, a recording tap on each draw); `rec` is filled.
 void record_frame(FrameSetup& s, Recording& rec);

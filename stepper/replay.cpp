@@ -11,7 +11,11 @@
 namespace prast::stepper {
 
 const BoundMaterial& material_of(const FrameSetup& s, const Recording& rec, std::uint32_t tri) {
-    return s.scene_renderer->material_of(s.scene.meshes[std::size_t(rec.draw_of(tri).mesh)]);
+    return draw_material(s, rec.draw_of(tri));
+}
+
+const BoundMaterial& draw_material(const FrameSetup& s, const DrawRecord& d) {
+    return s.scene_renderer->material_of(s.scene.meshes[std::size_t(d.mesh)]);
 }
 
 ClipReplay replay_clip(const FrameSetup& s, const Recording& rec, std::uint32_t tri) {
@@ -19,12 +23,16 @@ ClipReplay replay_clip(const FrameSetup& s, const Recording& rec, std::uint32_t 
     const DrawRecord& d = rec.draw_of(tri);
     const Mesh& mesh = s.scene.meshes[std::size_t(d.mesh)];
     const std::uint32_t prim = tri - d.first_triangle;
+    const int stride = d.stride();
+    c.stride = stride;
+    float full[3][kMaxStride];
     const float* v[3];
     c.valid = true;
     for (int i = 0; i < 3; ++i) {
         c.index[i] = mesh.indices[3 * std::size_t(prim) + std::size_t(i)];
         if (c.index[i] >= d.vertex_count) { c.valid = false; return c; }
-        v[i] = &d.vertices[std::size_t(c.index[i]) * kStride];
+        d.full_vertex(c.index[i], full[i]);
+        v[i] = full[i];
         for (int k = 0; k < 4; ++k) c.valid &= std::isfinite(v[i][k]);
     }
     if (!c.valid) return c;
@@ -33,22 +41,23 @@ ClipReplay replay_clip(const FrameSetup& s, const Recording& rec, std::uint32_t 
     c.planes = (c.outcode[0] | c.outcode[1] | c.outcode[2]) & kClipNeededBits;
     if ((c.outcode[0] & c.outcode[1] & c.outcode[2] & kFrustumBits) || !c.planes) {
         c.count = 3;
-        for (int i = 0; i < 3; ++i) std::memcpy(c.polygon[i], v[i], sizeof(float) * kStride);
+        for (int i = 0; i < 3; ++i) std::memcpy(c.polygon[i], v[i], sizeof(float) * std::size_t(stride));
         return c;
     }
-    float poly[kMaxClippedVertices * kStride];
-    c.count = clip_triangle(v, kStride, c.planes, gb, poly);
-    for (int i = 0; i < c.count; ++i) std::memcpy(c.polygon[i], &poly[i * kStride], sizeof(float) * kStride);
+    float poly[kMaxClippedVertices * kMaxStride];
+    c.count = clip_triangle(v, stride, c.planes, gb, poly);
+    for (int i = 0; i < c.count; ++i)
+        std::memcpy(c.polygon[i], &poly[std::size_t(i) * std::size_t(stride)], sizeof(float) * std::size_t(stride));
     return c;
 }
 
-void piece_vertices(const FrameSetup& s, const Recording& rec, std::uint32_t piece, float out[3][kStride]) {
+void piece_vertices_full(const FrameSetup& s, const Recording& rec, std::uint32_t piece, float out[3][kMaxStride]) {
     const PieceRecord& p = rec.pieces[piece];
     const TriangleSetup& t = rec.setups[p.setup];
     const DrawRecord& d = rec.draw_of(p.triangle);
+    const std::size_t bytes = sizeof(float) * std::size_t(d.stride());
     if (!(t.vtx[0] & kClippedVertexBit)) {
-        for (int i = 0; i < 3; ++i)
-            std::memcpy(out[i], &d.vertices[std::size_t(t.vtx[i]) * kStride], sizeof(float) * kStride);
+        for (int i = 0; i < 3; ++i) d.full_vertex(t.vtx[i], out[i]);
         return;
     }
     // A clipped piece k of the fan uses polygon vertices 0, k + 1, k + 2;
@@ -57,9 +66,14 @@ void piece_vertices(const FrameSetup& s, const Recording& rec, std::uint32_t pie
     const std::uint32_t base = std::min({t.vtx[0], t.vtx[1], t.vtx[2]}) & ~kClippedVertexBit;
     for (int i = 0; i < 3; ++i) {
         const std::uint32_t j = (t.vtx[i] & ~kClippedVertexBit) - base;
-        std::memcpy(out[i], c.polygon[std::min<std::uint32_t>(j, std::uint32_t(c.count - 1))],
-                    sizeof(float) * kStride);
+        std::memcpy(out[i], c.polygon[std::min<std::uint32_t>(j, std::uint32_t(c.count - 1))], bytes);
     }
+}
+
+void piece_vertices(const FrameSetup& s, const Recording& rec, std::uint32_t piece, float out[3][kStride]) {
+    float full[3][kMaxStride];
+    piece_vertices_full(s, rec, piece, full);
+    for (int i = 0; i < 3; ++i) std::memcpy(out[i], full[i], sizeof(float) * kStride);
 }
 
 SnappedVertex snap_vertex(const float* clip, int width, int height) {
@@ -75,29 +89,67 @@ SnappedVertex snap_vertex(const float* clip, int width, int height) {
     return v;
 }
 
-void replay_block(const FrameSetup& s, const Recording& rec, const BlockRecord& b, ReplayedBlock& out) {
-    const PieceRecord& p = rec.pieces[b.piece];
-    const TriangleSetup& t = rec.setups[p.setup];
-    float v[3][kStride];
-    piece_vertices(s, rec, b.piece, v);
-    constexpr int NV = kPbrVaryings;
+namespace {
+
+// interpolate_block() with the draw's own varying count.
+template <int NV>
+void interpolate_as(const Recording& rec, const TriangleSetup& t, const float v[3][kMaxStride], int bx, int by,
+                    std::uint32_t lanes, FragmentBlock<NV>& in) {
     raster_detail::TriangleVaryings<NV> pv;  // as prepare_varyings() makes them
     for (int k = 0; k < NV; ++k) {
         pv.v0[k] = v[0][4 + k];
         pv.d1[k] = v[1][4 + k] - v[0][4 + k];
         pv.d2[k] = v[2][4 + k] - v[0][4 + k];
     }
-    FragmentBlock<NV>& in = out.in;
     const SamplePattern& sp = sample_pattern(rec.samples);
-    const std::uint32_t lanes = b.shaded ? b.shaded : b.pass;  // the lanes the shader ran for
     // The rasterizer's own interpolation (shade.h), centroids included.
-    if (rec.samples > 1) raster_detail::interpolate_block<true, NV>(t, pv, sp, b.bx, b.by, lanes, nullptr, in);
-    else raster_detail::interpolate_block<false, NV>(t, pv, sp, b.bx, b.by, lanes, nullptr, in);
-    in.x = b.bx;
-    in.y = b.by;
+    if (rec.samples > 1) raster_detail::interpolate_block<true, NV>(t, pv, sp, bx, by, lanes, nullptr, in);
+    else raster_detail::interpolate_block<false, NV>(t, pv, sp, bx, by, lanes, nullptr, in);
+    in.x = bx;
+    in.y = by;
     in.mask = lanes;
     in.prim_id = t.prim_id;
     in.front_facing = t.front_facing;
+}
+
+// The narrow block's varyings from a wider one: the same values (each
+// varying is interpolated on its own).
+template <int NV, int NW>
+void narrow_block(const FragmentBlock<NW>& w, FragmentBlock<NV>& n) {
+    static_assert(NV <= NW, "narrowing");
+    for (int k = 0; k < NV; ++k) {
+        std::memcpy(n.var[k], w.var[k], sizeof n.var[k]);
+        std::memcpy(n.centre_var[k], w.centre_var[k], sizeof n.centre_var[k]);
+    }
+    std::memcpy(n.z, w.z, sizeof n.z);
+    n.x = w.x;
+    n.y = w.y;
+    n.mask = w.mask;
+    n.prim_id = w.prim_id;
+    n.front_facing = w.front_facing;
+    n.centroid_mask = w.centroid_mask;
+}
+
+} // namespace
+
+void replay_block(const FrameSetup& s, const Recording& rec, const BlockRecord& b, ReplayedBlock& out) {
+    const PieceRecord& p = rec.pieces[b.piece];
+    const TriangleSetup& t = rec.setups[p.setup];
+    const DrawRecord& d = rec.draw_of(p.triangle);
+    float v[3][kMaxStride];
+    piece_vertices_full(s, rec, b.piece, v);
+    const SamplePattern& sp = sample_pattern(rec.samples);
+    const std::uint32_t lanes = b.shaded ? b.shaded : b.pass;  // the lanes the shader ran for
+    out.varyings = d.varyings;
+    out.line = false;
+    out.has_color = d.varyings == kPbrVaryingsExt && !s.scene.meshes[std::size_t(d.mesh)].colors.empty();
+    FragmentBlock<kPbrVaryings>& in = out.in;
+    if (d.varyings == kPbrVaryingsExt) {
+        interpolate_as<kPbrVaryingsExt>(rec, t, v, b.bx, b.by, lanes, out.ext);
+        narrow_block(out.ext, in);
+    } else {
+        interpolate_as<kPbrVaryings>(rec, t, v, b.bx, b.by, lanes, in);
+    }
 
     // For display: the point each lane was interpolated at, its barycentrics
     // and perspective weights, with interpolate_block()'s float operations.
@@ -137,11 +189,44 @@ void replay_block(const FrameSetup& s, const Recording& rec, const BlockRecord& 
     }
 }
 
+SurfacePoint replay_surface_point(const ReplayedBlock& rb, int lane) {
+    if (rb.varyings == kPbrVaryingsExt) return PbrProgramExt::surface_point(rb.ext, lane, rb.has_color);
+    return PbrProgram::surface_point(rb.in, lane);
+}
+
 LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const ReplayedBlock& rb, int lane) {
     LaneShading r;
-    r.sp = PbrProgram::surface_point(rb.in, lane);
-    // The quad's lanes share their derivatives, hence their levels of detail.
-    r.lods = material_lods(bm, r.sp.duv_dx, r.sp.duv_dy);
+    if (rb.varyings == UnlitProgram::kVaryings) {
+        // UnlitProgram::fragment(), term by term; then the program itself on
+        // the block, whose lane must give the same bytes.
+        const FragmentBlock<UnlitProgram::kVaryings>& in = rb.unlit;
+        const Material& m = *bm.m;
+        r.unlit = true;
+        r.unlit_color = glm::vec4(in.var[2][lane], in.var[3][lane], in.var[4][lane], in.var[5][lane]);
+        glm::vec4 c = m.base_color_factor * r.unlit_color;
+        if (bm.base_color) {
+            r.unlit_texture = bm.base_color->sample(in.var[0][lane], in.var[1][lane], 0.0f, 0.0f, 0.0f, 0.0f);
+            c *= r.unlit_texture;
+        }
+        r.sp.uv = {in.var[0][lane], in.var[1][lane]};
+        r.sp.has_color = true;
+        r.sp.color = r.unlit_color;
+        r.ms.albedo = glm::vec3(c);
+        r.ms.alpha = c.a;
+        r.killed = m.alpha_mode == AlphaMode::Mask && !(c.a >= m.alpha_cutoff);
+        r.Lo = glm::vec3(c);
+        UnlitProgram prog;
+        prog.material = &bm;
+        FragmentOut out;
+        prog.fragment(in, out);
+        const glm::vec3 ref(out.r[lane], out.g[lane], out.b[lane]);
+        r.matches_shade_surface = std::memcmp(&ref, &r.Lo, sizeof ref) == 0 && r.killed == (((out.kill >> lane) & 1u) != 0);
+        return r;
+    }
+    r.sp = replay_surface_point(rb, lane);
+    // The quad's lanes share their derivatives, hence their levels of detail
+    // (each map's from the UV set it reads).
+    r.lods = material_lods(bm, r.sp);
     r.ms = sample_material(bm, r.sp, r.lods);
     r.killed = bm.m->alpha_mode == AlphaMode::Mask && !(r.ms.alpha >= bm.m->alpha_cutoff);
     // shade_surface(), one step at a time.
@@ -177,6 +262,110 @@ LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const
     const glm::vec3 ref = shade_surface(r.ms, r.sp, ctx);
     r.matches_shade_surface = std::memcmp(&ref, &Lo, sizeof Lo) == 0;
     return r;
+}
+
+LineReplay replay_line(const FrameSetup& s, const Recording& rec, std::size_t draw, std::uint32_t prim) {
+    // bin.h's bin_lines(), with the recorded vertices.
+    LineReplay r;
+    const DrawRecord& d = rec.draws[draw];
+    const Mesh& mesh = s.scene.meshes[std::size_t(d.mesh)];
+    const int stride = d.stride();
+    r.point = d.topology == Topology::Points;
+    const std::size_t per = r.point ? 1 : 2;
+    if (per * std::size_t(prim) + per > mesh.indices.size()) return r;
+    r.index[0] = mesh.indices[per * prim];
+    r.index[1] = mesh.indices[per * prim + per - 1];
+    if (r.index[0] >= d.vertex_count || r.index[1] >= d.vertex_count) return r;
+    float a[kMaxStride], b[kMaxStride];
+    d.full_vertex(r.index[0], a);
+    d.full_vertex(r.index[1], b);
+    r.valid = true;
+    for (int k = 0; k < 4; ++k) r.valid &= std::isfinite(a[k]) && std::isfinite(b[k]);
+    if (!r.valid) return r;
+    const GuardBand gb = GuardBand::for_viewport(rec.width, rec.height);
+    const std::uint32_t oc0 = outcode(a, gb), oc1 = outcode(b, gb);
+    std::memcpy(r.v[0], a, sizeof(float) * std::size_t(stride));
+    std::memcpy(r.v[1], b, sizeof(float) * std::size_t(stride));
+    if (r.point) {
+        r.drawn = !(oc0 & (kOutNear | kOutFar)) &&
+                  setup_point(window_vertex(a, rec.width, rec.height), r.index[0], rec.width, rec.height, r.setup);
+    } else if (oc0 & oc1 & kFrustumBits) {
+        r.drawn = false;
+    } else if (const std::uint32_t planes = (oc0 | oc1) & kClipNeededBits) {
+        r.planes = planes;
+        float seg[2 * kMaxStride];
+        r.drawn = clip_line(a, b, stride, planes, gb, seg);
+        if (r.drawn) {
+            std::memcpy(r.v[0], seg, sizeof(float) * std::size_t(stride));
+            std::memcpy(r.v[1], seg + stride, sizeof(float) * std::size_t(stride));
+            const std::uint32_t pref[2] = {kClippedVertexBit, 1u | kClippedVertexBit};
+            r.drawn = setup_line(window_vertex(r.v[0], rec.width, rec.height),
+                                 window_vertex(r.v[1], rec.width, rec.height), pref, rec.width, rec.height, r.setup);
+        }
+    } else {
+        r.drawn = setup_line(window_vertex(a, rec.width, rec.height), window_vertex(b, rec.width, rec.height),
+                             r.index, rec.width, rec.height, r.setup);
+    }
+    r.setup.prim_id = prim;
+    return r;
+}
+
+namespace {
+
+// line_block()'s values at one pixel, into every lane of its quad.
+template <int NV>
+void line_lanes(const LineReplay& l, float w1, float z, int lane, int bx, int by, FragmentBlock<NV>& in) {
+    float var[NV];
+    for (int k = 0; k < NV; ++k) {
+        const float v0 = l.v[0][4 + k], dv = l.v[1][4 + k] - l.v[0][4 + k];  // prepare_line_varyings()
+        var[k] = v0 + w1 * dv;
+    }
+    for (int j = 0; j < kBlockLanes; ++j) {
+        in.z[j] = z;
+        for (int k = 0; k < NV; ++k) in.var[k][j] = var[k];
+    }
+    in.x = bx;
+    in.y = by;
+    in.mask = 1u << lane;
+    in.prim_id = l.setup.prim_id;
+    in.front_facing = true;
+    in.centroid_mask = 0;
+}
+
+} // namespace
+
+void replay_line_fragment(const FrameSetup& s, const Recording& rec, std::size_t draw, const LineReplay& l, int x,
+                          int y, LineFragment& out) {
+    const DrawRecord& d = rec.draws[draw];
+    const LineSetup& ls = l.setup;
+    // line_block(): depth linear in window space, varyings perspective-correct.
+    out.t = line_parameter(ls, x, y);
+    const float zt = ls.z0 + out.t * (ls.z1 - ls.z0);
+    out.z = std::min(std::max(zt, 0.0f), 1.0f);
+    const float q0 = (1.0f - out.t) * ls.inv_w0, q1 = out.t * ls.inv_w1;
+    out.w1 = out.t > 0.0f ? q1 / (q0 + q1) : 0.0f;
+    const int bx = x & ~(kBlockSize - 1), by = y & ~(kBlockSize - 1);
+    int lane = 0;
+    for (int k = 0; k < kBlockLanes; ++k)
+        if (lane_x(k) == x - bx && lane_y(k) == y - by) lane = k;
+    ReplayedBlock& rb = out.block;
+    rb.varyings = d.varyings;
+    rb.line = true;
+    rb.has_color = d.varyings == kPbrVaryingsExt && !s.scene.meshes[std::size_t(d.mesh)].colors.empty();
+    if (d.varyings == UnlitProgram::kVaryings) {
+        line_lanes(l, out.w1, out.z, lane, bx, by, rb.unlit);
+    } else if (d.varyings == kPbrVaryingsExt) {
+        line_lanes(l, out.w1, out.z, lane, bx, by, rb.ext);
+        narrow_block(rb.ext, rb.in);
+    } else {
+        line_lanes(l, out.w1, out.z, lane, bx, by, rb.in);
+    }
+    for (int k = 0; k < kBlockLanes; ++k) {
+        rb.at_x[k] = rb.at_y[k] = 0.0f;
+        rb.centroid_of[k] = 0;
+        rb.bary[0][k] = 1.0f - out.t; rb.bary[1][k] = out.t; rb.bary[2][k] = 0.0f;
+        rb.persp[0][k] = 1.0f - out.w1; rb.persp[1][k] = out.w1; rb.persp[2][k] = 0.0f;
+    }
 }
 
 } // namespace prast::stepper

@@ -81,8 +81,13 @@ public:
     Tap tap() { return Tap{this, draws_++}; }
 
     void vertex(std::size_t draw, std::uint32_t v, const float* clip, const float* var, int nv) {
-        const float* r = &rec_.draws[draw].vertices[std::size_t(v) * kStride];
+        const DrawRecord& d = rec_.draws[draw];
         ++vertices_;
+        if (nv != d.varyings)
+            return fail("draw " + std::to_string(draw) + " writes " + std::to_string(nv) + " varyings, the recording keeps " +
+                        std::to_string(d.varyings));
+        float r[kMaxStride];
+        d.full_vertex(v, r);
         if (std::memcmp(r, clip, 4 * sizeof(float)) || std::memcmp(r + 4, var, std::size_t(nv) * sizeof(float)))
             fail("vertex " + std::to_string(v) + " of draw " + std::to_string(draw) + " differs");
     }
@@ -137,10 +142,13 @@ public:
         const std::string where = "block " + std::to_string(in.x) + "," + std::to_string(in.y) + " of tri " +
                                   std::to_string(rec_.pieces[b.piece].triangle);
         if (live != b.live) fail(where + ": written lanes differ");
-        if (std::memcmp(rb.in.var, in.var, sizeof in.var) || std::memcmp(rb.in.z, in.z, sizeof in.z) ||
-            rb.in.mask != in.mask || rb.in.front_facing != in.front_facing || rb.in.prim_id != in.prim_id ||
-            rb.in.centroid_mask != in.centroid_mask ||
-            (in.centroid_mask && std::memcmp(rb.in.centre_var, in.centre_var, sizeof in.centre_var)))
+        if (rb.varyings != NV) return fail(where + ": replayed with " + std::to_string(rb.varyings) + " varyings, drawn with " +
+                                           std::to_string(NV));
+        const FragmentBlock<NV>& ri = program_block<NV>(rb);
+        if (std::memcmp(ri.var, in.var, sizeof in.var) || std::memcmp(ri.z, in.z, sizeof in.z) ||
+            ri.mask != in.mask || ri.front_facing != in.front_facing || ri.prim_id != in.prim_id ||
+            ri.centroid_mask != in.centroid_mask ||
+            (in.centroid_mask && std::memcmp(ri.centre_var, in.centre_var, sizeof in.centre_var)))
             fail(where + ": recomputed varyings or depths differ from the rasterizer's");
         centroid_lanes_ += std::uint64_t(__builtin_popcount(in.centroid_mask));
         const BoundMaterial& bm = material_of(s_, rec_, rec_.pieces[b.piece].triangle);
@@ -166,6 +174,7 @@ public:
     std::vector<std::size_t> cursor_;
     std::size_t draws_ = 0;
     std::atomic<std::uint64_t> vertices_{0}, blocks_{0}, samples_{0}, shaded_blocks_{0}, pixels_{0}, centroid_lanes_{0};
+    std::uint64_t line_prims_ = 0, line_pixels_ = 0;
     std::mutex mutex_;
     std::uint64_t failures_ = 0;
     std::string first_;
@@ -190,6 +199,7 @@ Reply Session::help() const {
         "  help                 this list\n"
         "  frame                the frame's counters, camera, lights and the recording's size\n"
         "  tri N                triangle N: clip coordinates, clipping, fixed-point setup, edges, bins, tile walk\n"
+        "  tri draw D triangle P  the same for triangle P of draw D (the name pixel and render --pixel print)\n"
         "  tile X Y             the triangles binned to tile X Y (tile columns and rows), in order\n"
         "  pixel X Y            the history of pixel X Y and the shading breakdown of the winning fragment\n"
         "  upto N [FILE]        write the image after the first N triangles (default upto-N.png)\n"
@@ -226,7 +236,16 @@ Reply Session::run(const std::string& line) {
         return Reply{true, false, frame_text(s_, rec_)};
     }
     if (cmd == "tri") {
-        if (!args(1, 1)) return error("usage: tri N");
+        // tri N (the frame triangle) or tri draw D triangle P, as pixel and render --pixel name it.
+        if (args(4, 4) && w[1] == "draw" && w[3] == "triangle") {
+            std::uint32_t tri = 0;
+            if (!parse_int(w[2], 0, long(rec_.draws.size()) - 1, a) || !parse_int(w[4], 0, 1L << 40, b) ||
+                !frame_triangle(rec_, a, b, tri))
+                return error("tri draw '" + w[2] + "' triangle '" + w[4] + "': no such triangle (draws " +
+                             count_range(long(rec_.draws.size())) + ", triangles within the draw's mesh)");
+            return Reply{true, false, triangle_text(s_, rec_, tri)};
+        }
+        if (!args(1, 1)) return error("usage: tri N | tri draw D triangle P");
         if (!parse_int(w[1], 0, long(rec_.triangle_count()) - 1, a))
             return error("tri '" + w[1] + "': not a triangle number (" + count_range(rec_.triangle_count()) + ")");
         return Reply{true, false, triangle_text(s_, rec_, std::uint32_t(a))};
@@ -314,6 +333,37 @@ Reply Session::verify() {
     if (std::memcmp(fb.color.data(), rec_.fb.color.data(), fb.color.size() * sizeof(float)) ||
         fb.depth != rec_.fb.depth)
         obs.fail("the re-rendered framebuffer differs from the recorded one");
+    // Lines and points: the pipeline's observers see their vertices only, so
+    // every pixel one covers is explained (set up again, covered by line.h's
+    // test, depth-tested and shaded in order) and its colour compared with the frame's.
+    std::vector<std::uint8_t> line_pixel(std::size_t(rec_.width) * std::size_t(rec_.height), 0);
+    for (std::size_t di = 0; di < rec_.draws.size(); ++di) {
+        const DrawRecord& d = rec_.draws[di];
+        if (d.topology == Topology::Triangles) continue;
+        for (std::uint32_t prim = 0; prim < d.primitives; ++prim) {
+            const LineReplay l = replay_line(s_, rec_, di, prim);
+            if (!l.drawn) continue;
+            ++obs.line_prims_;
+            for_each_line_pixel(l.setup, 0, 0, rec_.width - 1, rec_.height - 1,
+                                [&](int x, int y) { line_pixel[std::size_t(y) * std::size_t(rec_.width) + std::size_t(x)] = 1; });
+        }
+    }
+    for (int y = 0; y < rec_.height; ++y)
+        for (int x = 0; x < rec_.width; ++x) {
+            if (!line_pixel[std::size_t(y) * std::size_t(rec_.width) + std::size_t(x)]) continue;
+            ++obs.line_pixels_;
+            const PixelExplanation px = explain_pixel(s_, rec_, x, y);
+            const float* c = rec_.fb.pixel(x, y);
+            const glm::vec3 frame(c[0], c[1], c[2]);
+            bool shading_ok = true;
+            for (const HistoryEntry& h : px.history)
+                shading_ok &= !h.shaded || h.shading.matches_shade_surface;
+            if (std::memcmp(&frame, &px.linear, sizeof frame) || !shading_ok)
+                obs.fail("pixel " + std::to_string(x) + "," + std::to_string(y) + " (a line or point covers it): explained " +
+                         vec(px.linear) + ", the frame holds " + vec(frame));
+        }
+    if (rec_.layout_mismatches)
+        obs.fail(std::to_string(rec_.layout_mismatches) + " vertices recorded with another varying count than the draw's");
     Framebuffer plain;
     draw_plain(s_, plain);
     if (std::memcmp(plain.color.data(), rec_.fb.color.data(), plain.color.size() * sizeof(float)))
@@ -325,7 +375,11 @@ Reply Session::verify() {
       << "  " << obs.samples_ << " covered samples (" << rec_.samples << " per pixel): coverage, depth test, depth\n"
       << "  " << obs.shaded_blocks_ << " shaded blocks: recomputed barycentrics, depths and varyings of all 16 lanes ("
       << obs.centroid_lanes_ << " lanes at a centroid)\n"
-      << "  " << obs.pixels_ << " written pixels: recomputed shading (scalar path) against the shader's output\n"
+      << "  " << obs.pixels_ << " written pixels: recomputed shading (scalar path) against the shader's output\n";
+    if (obs.line_prims_)
+        o << "  " << obs.line_prims_ << " lines and points set up again, " << obs.line_pixels_
+          << " pixels they cover explained: colour against the frame's\n";
+    o
       << "  the framebuffer against the recording's and SceneRenderer::render's\n";
     if (obs.failures_) {
         o << "verify: FAILED (" << obs.failures_ << " differences; first: " << obs.first_ << ")\n";

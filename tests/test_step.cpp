@@ -4,7 +4,11 @@
 // built-in scene, the tea set and NormalTangentTest; `verify` finds every
 // recomputed number equal to the pipeline's; scripted sessions against the
 // expected transcripts in tests/step/ (the same for 1 and 2 threads); bad
-// commands and bad flags.
+// commands and bad flags. Core glTF on models the tests write
+// (tests/gltf_writer.h): vertex colours, UV set 1 through a NEAREST sampler,
+// a skinned model posed at a time, lines and points, each explained, equal to
+// render's bytes and verified; render --pixel naming step's winner; the
+// frame's environment, ambient and shadows.
 //
 // Regenerate the transcripts only deliberately, after reading the diff:
 //   PRAST_STEP_REGENERATE=1 build/prast_tests -ts=step
@@ -19,9 +23,17 @@
 #include <string>
 #include <vector>
 
+#include <regex>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/write_image.h"
 #include "tests/cli_util.h"
+#include "tests/gltf_writer.h"
 
 using namespace prast::cli_test;
+using prast::gltf_test::GltfWriter;
+using nlohmann::json;
 
 namespace {
 
@@ -175,6 +187,126 @@ void check_transcript(const std::string& name, const std::vector<std::string>& f
         REQUIRE(got[i] == want[i]);
     }
     CHECK(got.size() == want.size());
+}
+
+
+// ---- Small glTF models for the core glTF features (tests/gltf_writer.h).
+
+// A quad x, y in [-1, 1] at z = 0 facing +z (two triangles, counter-clockwise
+// seen from +z), with normals, UV set 0 over [0, 1]^2 and `extra` attributes.
+int add_quad(GltfWriter& g, float z, const json& extra_attributes, int material, bool with_normals = true) {
+    const int pos = g.floats({-1, -1, z, 1, -1, z, 1, 1, z, -1, 1, z}, "VEC3", 3);
+    json attrs = {{"POSITION", pos}};
+    if (with_normals) attrs["NORMAL"] = g.floats({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3", 3);
+    attrs["TEXCOORD_0"] = g.floats({0, 1, 1, 1, 1, 0, 0, 0}, "VEC2", 2);
+    for (auto it = extra_attributes.begin(); it != extra_attributes.end(); ++it) attrs[it.key()] = it.value();
+    const int ind = g.u16({0, 1, 2, 0, 2, 3}, "SCALAR", 1);
+    g.doc["meshes"].push_back({{"name", "quad" + std::to_string(g.doc["meshes"].size())},
+                               {"primitives", json::array({{{"attributes", attrs}, {"indices", ind}, {"material", material}}})}});
+    return int(g.doc["meshes"].size()) - 1;
+}
+
+int add_material(GltfWriter& g, const json& m) {
+    g.doc["materials"].push_back(m);
+    return int(g.doc["materials"].size()) - 1;
+}
+
+std::string write_gltf(CliSandbox& box, const GltfWriter& g, const std::string& name) {
+    write_text(box.path(name), g.text());
+    return box.path(name);
+}
+
+// A 4x4 RGBA checker of four colours (2x2 texels each) as PNG bytes.
+std::vector<unsigned char> checker_png() {
+    std::vector<std::uint8_t> rgba(4 * 4 * 4);
+    const std::uint8_t colours[4][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0}};
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) {
+            const std::uint8_t* c = colours[(y / 2) * 2 + x / 2];
+            std::uint8_t* p = &rgba[std::size_t(y * 4 + x) * 4];
+            p[0] = c[0]; p[1] = c[1]; p[2] = c[2]; p[3] = 255;
+        }
+    const std::vector<std::uint8_t> png = prast::encode_png(4, 4, rgba.data());
+    return std::vector<unsigned char>(png.begin(), png.end());
+}
+
+const std::vector<std::string> kQuadView = {"--eye", "0,0,3", "--target", "0,0,0", "--size", "48x36", "--msaa", "1",
+                                            "--sun", "0,0,1:1,1,1"};
+
+// Every pixel of `pixels`: step's explanation against render's PNG bytes; the
+// step transcript for the caller.
+std::string check_listed_pixels(CliSandbox& box, const std::vector<std::string>& flags,
+                                const std::vector<std::pair<int, int>>& pixels) {
+    std::vector<std::string> png_args = flags;
+    png_args.insert(png_args.end(), {"-o", "r.png"});
+    REQUIRE(box.run_exe(kRender, png_args).code == 0);
+    const Rgb8 png = load_rgb8(box.path("r.png"));
+    REQUIRE(!png.empty());
+    std::string commands;
+    for (const auto& [x, y] : pixels) commands += "pixel " + std::to_string(x) + " " + std::to_string(y) + "\n";
+    const CliRun r = run_step(box, flags, commands);
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    const std::vector<PixelAnswer> answers = pixel_answers(r.out);
+    REQUIRE(answers.size() == pixels.size());
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+        const std::uint8_t* p = png.at(pixels[i].first, pixels[i].second);
+        INFO("pixel " << pixels[i].first << " " << pixels[i].second);
+        CHECK(answers[i].srgb[0] == p[0]);
+        CHECK(answers[i].srgb[1] == p[1]);
+        CHECK(answers[i].srgb[2] == p[2]);
+    }
+    return r.out;
+}
+
+std::vector<std::pair<int, int>> grid(int w, int h, int step) {
+    std::vector<std::pair<int, int>> out;
+    for (int y = step / 2; y < h; y += step)
+        for (int x = step / 2; x < w; x += step) out.push_back({x, y});
+    return out;
+}
+
+void check_verify(CliSandbox& box, const std::vector<std::string>& flags, const char* expect = nullptr) {
+    const CliRun r = run_step(box, flags, "verify\n");
+    INFO(r.out << r.err);
+    CHECK(r.code == 0);
+    CHECK(r.out.find("verify: ok, all identical") != std::string::npos);
+    if (expect) CHECK(r.out.find(expect) != std::string::npos);
+}
+
+// The answer blocks of a transcript of `pixel` commands, one string each.
+std::vector<std::string> pixel_blocks(const std::string& out) {
+    std::vector<std::string> blocks;
+    std::string cur;
+    for (const std::string& l : lines_of(out)) {
+        cur += l + "\n";
+        if (l.rfind("srgb8 ", 0) == 0) {
+            blocks.push_back(cur);
+            cur.clear();
+        }
+    }
+    return blocks;
+}
+
+// The name of the fragment step's pixel explanation shades first (the
+// winner): "draw D (mesh 'M') triangle P (frame triangle N)", or "" when none.
+std::string step_winner(const std::string& block) {
+    std::smatch m;
+    if (!std::regex_search(block, m, std::regex("\nshading of #([0-9]+) "))) return "";
+    const std::string entry = "\n  #" + m[1].str() + " ";
+    const std::size_t at = block.find(entry);
+    if (at == std::string::npos) return "";
+    const std::string line = block.substr(at + entry.size(), block.find('\n', at + 1) - at - entry.size());
+    if (!std::regex_search(line, m, std::regex("draw [0-9]+ \\(mesh '[^']*'\\) triangle [0-9]+ \\(frame triangle [0-9]+\\)")))
+        return "";
+    return m[0].str();
+}
+
+std::string render_winner(const std::string& out) {
+    std::smatch m;
+    if (!std::regex_search(out, m, std::regex("draw [0-9]+ \\(mesh '[^']*'\\) triangle [0-9]+ \\(frame triangle [0-9]+\\)")))
+        return "";
+    return m[0].str();
 }
 
 } // namespace
@@ -430,6 +562,269 @@ TEST_CASE("flags: render's flags that make no sense for one frame, and bad files
     const CliRun pixel = box.run_exe(kStep, {"--size", "160x90", "--pixel", "80,60"});
     CHECK(pixel.code == 0);
     CHECK(pixel_answers(pixel.out).size() == 1);
+}
+
+
+TEST_CASE("core glTF: vertex colours, the base colour term and the exact interpolated colour") {
+    CliSandbox box;
+    GltfWriter g;
+    const int mat = add_material(g, {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 1, 1, 1}}, {"metallicFactor", 0}}}});
+    // Quad 0: red grows with x (r = (x + 1) / 2), green and blue constant.
+    const int colors = g.floats({0, 0.25f, 0.75f, 1, 1, 0.25f, 0.75f, 1, 1, 0.25f, 0.75f, 1, 0, 0.25f, 0.75f, 1}, "VEC4", 4);
+    add_quad(g, 0.0f, {{"COLOR_0", colors}}, mat);
+    g.scene_of_meshes();
+    const std::string file = write_gltf(box, g, "colours.gltf");
+    std::vector<std::string> flags = kQuadView;
+    flags.insert(flags.begin(), file);
+    const std::string out = check_listed_pixels(box, flags, grid(48, 36, 5));
+    check_verify(box, flags);
+    // Every explained fragment shows its colour and the base colour product.
+    const std::regex colour("vertex colour \\(COLOR_0, interpolated\\) \\(([-0-9.e]+), ([-0-9.e]+), ([-0-9.e]+), ([-0-9.e]+)\\)");
+    const std::regex P("\n     P \\(([-0-9.e]+), ([-0-9.e]+), ([-0-9.e]+)\\)");
+    int seen = 0;
+    for (const std::string& b : pixel_blocks(out)) {
+        std::smatch m, p;
+        if (!std::regex_search(b, m, colour)) continue;
+        REQUIRE(std::regex_search(b, p, P));
+        ++seen;
+        const float r = std::stof(m[1]), px = std::stof(p[1]);
+        INFO(b);
+        CHECK(std::fabs(r - (px + 1.0f) / 2.0f) <= 2e-6f);  // interpolated like P: exact up to float rounding
+        CHECK(m[2].str() == "0.25");                        // constant across the quad: exactly
+        CHECK(m[3].str() == "0.75");
+        CHECK(m[4].str() == "1");
+        CHECK(b.find("base colour = factor (0.5, 1, 1, 1) x vertex colour (" + m[1].str() + ", 0.25, 0.75, 1) = (") !=
+              std::string::npos);
+        CHECK(b.find(" colour (" + m[1].str() + ", 0.25, 0.75, 1)\n") != std::string::npos);  // the history line
+    }
+    CHECK(seen > 20);
+}
+
+TEST_CASE("core glTF: a texture on UV set 1 through a NEAREST sampler, explained and equal to render") {
+    CliSandbox box;
+    GltfWriter g;
+    const int img = g.image_png(checker_png());
+    const int tex = g.texture(img, 9728 /*NEAREST*/, 9729 /*LINEAR*/, 33071 /*CLAMP*/, 10497);
+    const int mat = add_material(g, {{"pbrMetallicRoughness",
+                                      {{"baseColorTexture", {{"index", tex}, {"texCoord", 1}}}, {"metallicFactor", 0}}}});
+    // UV set 1 is UV set 0 mirrored in u: the explanation must read set 1.
+    const int uv1 = g.floats({1, 1, 0, 1, 0, 0, 1, 0}, "VEC2", 2);
+    add_quad(g, 0.0f, {{"TEXCOORD_1", uv1}}, mat);
+    g.scene_of_meshes();
+    const std::string file = write_gltf(box, g, "uv1.gltf");
+    std::vector<std::string> flags = kQuadView;
+    flags.insert(flags.begin(), file);
+    const std::string out = check_listed_pixels(box, flags, grid(48, 36, 5));
+    check_verify(box, flags);
+    CHECK(out.find("map base_color: 4x4, 3 levels, UV set 1 (") != std::string::npos);
+    CHECK(out.find("sampler: mag NEAREST, min LINEAR, wrap clamp/repeat") != std::string::npos);
+    CHECK(out.find("(magnification: nearest on level 0)") != std::string::npos);
+    CHECK(out.find("nearest texel x ") != std::string::npos);
+    CHECK(out.find("base colour = factor (1, 1, 1, 1) x texture(UV set 1, sampler: mag NEAREST") != std::string::npos);
+    CHECK(out.find(" uv1 (") != std::string::npos);
+    const CliRun t = run_step(box, flags, "tri 0\n");
+    CHECK(t.out.find("18 varyings (vertex colours or UV set 1)") != std::string::npos);
+}
+
+TEST_CASE("core glTF: a skinned, animated model posed at a time: step equals render and verify passes") {
+    CliSandbox box;
+    GltfWriter g;
+    // A strip of two quads (rows y = 0, 1, 2) on two joints; joint 1 turns about z over [0, 1].
+    const int pos = g.floats({-0.5f, 0, 0, 0.5f, 0, 0, -0.5f, 1, 0, 0.5f, 1, 0, -0.5f, 2, 0, 0.5f, 2, 0}, "VEC3", 3);
+    const int nrm = g.floats({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3", 3);
+    const int col = g.floats({1, 0, 0, 1, 1, 0, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 0, 0, 1, 1}, "VEC4", 4);
+    const int joints = g.u16({0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0}, "VEC4", 4);
+    const int weights = g.floats({1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 0.5f, 0.5f, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0},
+                                 "VEC4", 4);
+    const int ind = g.u16({0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4}, "SCALAR", 1);
+    const int ibm = g.floats({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1},
+                             "MAT4", 16);
+    const int mat = add_material(g, {{"pbrMetallicRoughness", {{"metallicFactor", 0}}}, {"doubleSided", true}});
+    g.doc["meshes"].push_back(
+        {{"name", "strip"},
+         {"primitives", json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}, {"COLOR_0", col},
+                                                      {"JOINTS_0", joints}, {"WEIGHTS_0", weights}}},
+                                      {"indices", ind},
+                                      {"material", mat}}})}});
+    g.doc["nodes"] = json::array({{{"name", "root"}, {"children", {1}}},
+                                  {{"name", "bone"}, {"translation", {0, 1, 0}}},
+                                  {{"name", "strip"}, {"mesh", 0}, {"skin", 0}}});
+    g.doc["skins"] = json::array({{{"joints", {0, 1}}, {"inverseBindMatrices", ibm}}});
+    g.doc["scenes"] = json::array({{{"nodes", {0, 2}}}});
+    g.doc["scene"] = 0;
+    const double h = std::sqrt(0.5);
+    const int in = g.floats({0, 1}, "SCALAR", 1);
+    const int out = g.floats({0, 0, 0, 1, 0, 0, float(h), float(h)}, "VEC4", 4);
+    g.doc["animations"] = json::array(
+        {{{"name", "bend"},
+          {"samplers", json::array({{{"input", in}, {"output", out}}})},
+          {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 1}, {"path", "rotation"}}}}})}}});
+    const std::string file = write_gltf(box, g, "skinned.gltf");
+    const std::vector<std::string> flags = {file, "--size", "40x40", "--time", "0.5", "--msaa", "1"};
+    const std::string t = check_listed_pixels(box, flags, grid(40, 40, 4));
+    CHECK(t.find("vertex colour (COLOR_0, interpolated) (") != std::string::npos);
+    check_verify(box, flags);
+    check_verify(box, {file, "--size", "40x40", "--time", "0.5"});  // 4 samples
+}
+
+TEST_CASE("core glTF: lines and points, unlit, explained by the diamond-exit rule and equal to render") {
+    CliSandbox box;
+    GltfWriter g;
+    const int grey = add_material(g, {{"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.2, 0.2, 1}}, {"metallicFactor", 0}}}});
+    const int white = add_material(g, {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 0.5, 1, 1}}}}});
+    add_quad(g, -0.5f, json::object(), grey);
+    // Lines (mode 1): a horizontal one through the middle and a diagonal, with colours; no normals.
+    const int lpos = g.floats({-2, 0.1f, 0, 2, 0.1f, 0, -1, -1, 0.2f, 1, 1, 0.2f}, "VEC3", 3);
+    const int lcol = g.floats({1, 0, 0, 1, 0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 0, 1}, "VEC4", 4);
+    const int lind = g.u16({0, 1, 2, 3}, "SCALAR", 1);
+    g.doc["meshes"].push_back({{"name", "lines"},
+                               {"primitives", json::array({{{"attributes", {{"POSITION", lpos}, {"COLOR_0", lcol}}},
+                                                            {"indices", lind}, {"mode", 1}, {"material", white}}})}});
+    // Points (mode 0) in front of everything.
+    const int ppos = g.floats({-0.6f, -0.6f, 0.5f, 0.6f, -0.6f, 0.5f}, "VEC3", 3);
+    g.doc["meshes"].push_back({{"name", "points"},
+                               {"primitives", json::array({{{"attributes", {{"POSITION", ppos}}}, {"mode", 0},
+                                                            {"material", white}}})}});
+    g.scene_of_meshes();
+    const std::string file = write_gltf(box, g, "lines.gltf");
+    for (const char* msaa : {"1", "4"}) {
+        INFO("--msaa " << msaa);
+        const std::vector<std::string> flags = {file, "--eye", "0,0,3", "--target", "0,0,0", "--size", "48x36",
+                                                "--msaa", msaa, "--sun", "0,0,1:1,1,1"};
+        check_verify(box, flags, " lines and points set up again, ");
+        // Every pixel of the image: the lines' and points' pixels among them.
+        const std::string out = check_listed_pixels(box, flags, grid(48, 36, 1));
+        CHECK(out.find("line fragment: segment from (") != std::string::npos);
+        CHECK(out.find("coverage rule (diamond exit): the segment meets the pixel's diamond") != std::string::npos);
+        CHECK(out.find("point fragment: at (") != std::string::npos);
+        CHECK(out.find("unlit (a line or point without normals") != std::string::npos);
+        CHECK(out.find("base colour = factor (1, 0.5, 1, 1) x vertex colour (") != std::string::npos);
+        CHECK(out.find("shaded in order (lines and points always are): unlit, shader out") != std::string::npos);
+        CHECK(out.find("base colour = factor (1, 0.5, 1, 1) x vertex colour (1, 1, 1, 1) = (1, 0.5, 1, 1)") !=
+              std::string::npos);  // the points: no COLOR_0, white
+    }
+}
+
+TEST_CASE("render --pixel names step's winner: a back face behind a front face, a coincident double-sided pair") {
+    CliSandbox box;
+    GltfWriter g;
+    const int front = add_material(g, {{"name", "front"}, {"pbrMetallicRoughness", {{"baseColorFactor", {1, 0, 0, 1}}}}});
+    const int twosided = add_material(g, {{"name", "twosided"}, {"doubleSided", true},
+                                          {"pbrMetallicRoughness", {{"baseColorFactor", {0, 1, 0, 1}}}}});
+    const int twin = add_material(g, {{"name", "twin"}, {"doubleSided", true},
+                                      {"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 1, 1}}}}});
+    // Mesh 0: a small front-facing quad in front (x, y in [-0.4, 0.4] at z = 0.5).
+    {
+        const int pos = g.floats({-0.4f, -0.4f, 0.5f, 0.4f, -0.4f, 0.5f, 0.4f, 0.4f, 0.5f, -0.4f, 0.4f, 0.5f}, "VEC3", 3);
+        const int nrm = g.floats({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3", 3);
+        const int ind = g.u16({0, 1, 2, 0, 2, 3}, "SCALAR", 1);
+        g.doc["meshes"].push_back({{"name", "front"}, {"primitives", json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}},
+                                                                                   {"indices", ind}, {"material", front}}})}});
+    }
+    // Mesh 1: a double-sided quad behind it wound the other way (a back face to the camera).
+    {
+        const int pos = g.floats({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, "VEC3", 3);
+        const int nrm = g.floats({0, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1}, "VEC3", 3);
+        const int ind = g.u16({0, 2, 1, 0, 3, 2}, "SCALAR", 1);
+        g.doc["meshes"].push_back({{"name", "back"}, {"primitives", json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}},
+                                                                                  {"indices", ind}, {"material", twosided}}})}});
+    }
+    // Meshes 2 and 3: two coincident double-sided quads further back, wider: the first drawn keeps the ties.
+    for (int k = 0; k < 2; ++k) {
+        const int pos = g.floats({-2, -2, -0.5f, 2, -2, -0.5f, 2, 2, -0.5f, -2, 2, -0.5f}, "VEC3", 3);
+        const int nrm = g.floats({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3", 3);
+        const int ind = g.u16({0, 1, 2, 0, 2, 3}, "SCALAR", 1);
+        g.doc["meshes"].push_back({{"name", k ? "pair1" : "pair0"},
+                                   {"primitives", json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}},
+                                                                {"indices", ind}, {"material", twin}}})}});
+    }
+    g.scene_of_meshes();
+    const std::string file = write_gltf(box, g, "faces.gltf");
+    for (const char* msaa : {"1", "4"}) {
+        const std::vector<std::string> flags = {file, "--eye", "0,0,3", "--target", "0,0,0", "--size", "48x36",
+                                                "--msaa", msaa, "--sun", "0,0,1:1,1,1"};
+        std::string commands;
+        const std::vector<std::pair<int, int>> pixels = grid(48, 36, 3);
+        for (const auto& [x, y] : pixels) commands += "pixel " + std::to_string(x) + " " + std::to_string(y) + "\n";
+        const std::vector<std::string> blocks = pixel_blocks(run_step(box, flags, commands).out);
+        REQUIRE(blocks.size() == pixels.size());
+        int back = 0, pair = 0, fronts = 0;
+        for (std::size_t i = 0; i < pixels.size(); ++i) {
+            std::vector<std::string> args = flags;
+            args.insert(args.end(), {"--pixel", std::to_string(pixels[i].first) + "," + std::to_string(pixels[i].second),
+                                     "-o", "p.png"});
+            const CliRun r = box.run_exe(kRender, args);
+            REQUIRE(r.code == 0);
+            const std::string want = step_winner(blocks[i]);
+            INFO("--msaa " << msaa << " pixel " << pixels[i].first << " " << pixels[i].second << "\n" << r.out << blocks[i]);
+            CHECK(render_winner(r.out) == want);
+            back += want.find("(mesh 'back')") != std::string::npos && r.out.find(", back face") != std::string::npos;
+            pair += want.find("(mesh 'pair0')") != std::string::npos;
+            fronts += want.find("(mesh 'front')") != std::string::npos;
+            CHECK(want.find("(mesh 'pair1')") == std::string::npos);  // ties keep the first drawn
+            if (!want.empty()) {
+                // step's tri takes the name as printed.
+                std::smatch m;
+                REQUIRE(std::regex_search(want, m, std::regex("draw ([0-9]+) .* triangle ([0-9]+) \\(frame triangle ([0-9]+)\\)")));
+                const CliRun t = run_step(box, flags, "tri draw " + m[1].str() + " triangle " + m[2].str() + "\n");
+                CHECK(t.out.rfind("tri " + m[3].str() + ": " + want, 0) == 0);
+            }
+        }
+        CHECK(back > 5);
+        CHECK(pair > 5);
+        CHECK(fronts > 5);
+    }
+}
+
+TEST_CASE("render --pixel on the tea set names step's winner (a back face of 'Circle.001')") {
+    const std::string venice = kAssets + "/venice-sunset-1k/venice_sunset_1k.hdr";
+    if (!have_asset(kTea) || !have_asset(venice)) return;
+    CliSandbox box;
+    std::vector<std::string> flags = kTeaFlags;
+    flags.insert(flags.end(), {"--size", "640x480", "--msaa", "1", "--env", venice});
+    std::vector<std::string> args = flags;
+    args.insert(args.end(), {"--pixel", "273,169", "-o", "t.png"});
+    const CliRun r = box.run_exe(kRender, args);
+    REQUIRE(r.code == 0);
+    const CliRun s = run_step(box, flags, "pixel 273 169\n");
+    REQUIRE(s.code == 0);
+    const std::string want = step_winner(s.out);
+    INFO(r.out << s.out);
+    CHECK(!want.empty());
+    CHECK(render_winner(r.out) == want);
+    CHECK(want.find("(mesh 'Circle.001')") != std::string::npos);
+    CHECK(r.out.find(", back face") != std::string::npos);
+}
+
+TEST_CASE("frame: names the environment that lights the frame, the ambient only when it does, and the shadows") {
+    CliSandbox box;
+    // The built-in scene: its own sky lights it.
+    CliRun r = run_step(box, {"--size", "160x90"}, "frame\n");
+    REQUIRE(r.code == 0);
+    CHECK(r.out.find("environment built-in sky, ") != std::string::npos);
+    CHECK(r.out.find("in place of the ambient term") != std::string::npos);
+    CHECK(r.out.find("\nambient (") == std::string::npos);
+    CHECK(r.out.find("\nshadows off\n") != std::string::npos);
+    // Shadows on: which lights cast, the map sizes, bias and filter.
+    r = run_step(box, {"--size", "160x90", "--shadows", "on", "--shadow-size", "512"}, "frame\n");
+    CHECK(r.out.find("shadows on: light 0 directional map 512x512; light 1 cube map, 6 faces of 256x256; bias 1 + 3 "
+                     "tan(theta) texels, PCF 3x3 bilinear taps") != std::string::npos);
+    // A model without an environment: the ambient lights it.
+    GltfWriter g;
+    add_quad(g, 0.0f, json::object(), add_material(g, {{"pbrMetallicRoughness", {{"metallicFactor", 0}}}}));
+    g.scene_of_meshes();
+    const std::string file = write_gltf(box, g, "quad.gltf");
+    r = run_step(box, {file, "--size", "48x36", "--ambient", "0.1,0.2,0.3"}, "frame\n");
+    CHECK(r.out.find("\nambient (0.1, 0.2, 0.3), brdf default") != std::string::npos);
+    CHECK(r.out.find("\nenvironment ") == std::string::npos);
+    // An --env file: named, with its size.
+    const std::string venice = kAssets + "/venice-sunset-1k/venice_sunset_1k.hdr";
+    if (have_asset(venice)) {
+        r = run_step(box, {file, "--size", "48x36", "--env", venice}, "frame\n");
+        CHECK(r.out.find("environment file '" + venice + "', 1024x512, intensity 1, rotated 0 degrees: split sum") !=
+              std::string::npos);
+        CHECK(r.out.find("\nambient (") == std::string::npos);
+    }
 }
 
 } // TEST_SUITE
