@@ -289,8 +289,9 @@ std::string frame_text(const FrameSetup& s, const Recording& rec) {
       << rec.tiles_y << "), " << rec.samples << " sample" << (rec.samples == 1 ? "" : "s") << " per pixel\n";
     o << "scene " << (s.request.scene.empty() ? "built-in" : s.request.scene) << ": " << rec.triangle_count()
       << " triangles, " << s.scene.meshes.size() << " meshes, " << s.scene.materials.size() << " materials\n";
-    o << "camera eye " << vec(c.eye) << " target " << vec(c.target) << " up " << vec(c.up) << " fov "
-      << num(c.fov_y_deg) << " near " << num(c.near_plane) << " far " << num(c.far_plane) << "\n";
+    o << "camera eye " << vec(c.eye) << " target " << vec(c.target) << " up " << vec(c.up)
+      << (c.orthographic ? " orthographic, half height " + num(c.ortho_ymag) : " fov " + num(c.fov_y_deg)) << " near "
+      << num(c.near_plane) << " far " << (c.infinite_far ? std::string("infinite") : num(c.far_plane)) << "\n";
     for (std::size_t i = 0; i < s.settings.lights.size(); ++i) {
         const ShadingLight& L = s.settings.lights[i];
         o << "light " << i << ": " << (L.point ? "point at " + vec(L.position) : "sun towards " + vec(L.direction))

@@ -670,4 +670,27 @@ TEST_CASE("an animated scale that turns mirrored turns the winding; lights follo
     CHECK(read_bytes(box.path("s1.png")) == read_bytes(box.path("l1.png")));
 }
 
+TEST_CASE("step's frame names an orthographic file camera's half height, and a perspective one's infinite far") {
+    CliSandbox box;
+    const std::string file = quad_with_cameras().write(box, "cams.gltf");
+    const fs::path dir = box.work().parent_path();
+    write_text(dir / "stdin.txt", "frame\n");
+    auto frame_text = [&](const std::string& camera) {
+        const std::string cmd = "cd " + shell_quote(box.work().string()) + " && " + shell_quote(kStep) + " " +
+                                shell_quote(file) + " --size 32x32 --camera " + camera + " <" +
+                                shell_quote((dir / "stdin.txt").string()) + " >" +
+                                shell_quote((dir / "step.txt").string()) + " 2>&1";
+        REQUIRE(std::system(cmd.c_str()) == 0);
+        for (const std::string& l : lines_of(read_text(dir / "step.txt")))
+            if (l.rfind("camera eye ", 0) == 0) return l;
+        return std::string();
+    };
+    const std::string ortho = frame_text("ortho");
+    CHECK(ortho.find(" orthographic, half height 1 near 0.1 far 100") != std::string::npos);
+    CHECK(ortho.find(" fov ") == std::string::npos);
+    const std::string persp = frame_text("persp");
+    CHECK(persp.find(" fov ") != std::string::npos);
+    CHECK(persp.find(" far infinite") != std::string::npos);  // the file gives no zfar
+}
+
 } // TEST_SUITE
