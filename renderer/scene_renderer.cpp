@@ -16,11 +16,21 @@ std::vector<ShadingLight> shading_lights(const Scene& scene) {
     std::vector<ShadingLight> out;
     for (const Light& L : scene.lights) {
         ShadingLight s;
-        s.point = L.type == Light::Type::Point;
+        s.point = L.type == Light::Type::Point || L.type == Light::Type::Spot;
         float len = glm::length(L.direction);
         s.direction = len > 0.0f ? L.direction / len : glm::vec3(0.0f, 1.0f, 0.0f);
         s.position = L.position;
         s.radiance = L.color * L.intensity;
+        // KHR_lights_punctual: the spot cone and the range window (the loader
+        // checked the numbers; here only what is drawable passes).
+        if (L.type == Light::Type::Spot) {
+            s.spot = true;
+            spot_cone(L.inner_cone, L.outer_cone, s.cone_scale, s.cone_offset);
+        }
+        if (s.point && std::isfinite(L.range) && L.range > 0.0f) {
+            const double inv = 1.0 / (double(L.range) * double(L.range));
+            s.range_inv2 = std::isfinite(float(inv)) ? float(inv) : 0.0f;
+        }
         out.push_back(s);
     }
     return out;
@@ -75,7 +85,7 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
             if (slot_of(*r, srgb) >= 0) direct[std::size_t(slot_of(*r, srgb))] = 1;
         const int rs = slot_of(m.roughness, false), ms = slot_of(m.metallic, false);
         if (rs >= 0 && ms >= 0 && rs != ms && !m.metallic_roughness.valid() && wraps_of(rs) == wraps_of(ms) &&
-            m.roughness.texcoord == m.metallic.texcoord) {
+            m.roughness.texcoord == m.metallic.texcoord && m.roughness.transform == m.metallic.transform) {
             const auto key = std::make_pair(rs, ms);
             auto it = std::find(packs.begin(), packs.end(), key);
             material_pack[mi] = int(it - packs.begin());
@@ -187,6 +197,16 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
         b.uv.metallic = set_of(m.metallic);
         b.uv.normal = set_of(m.normal);
         b.uv.occlusion = set_of(m.occlusion);
+        // KHR_texture_transform, for the maps that have one.
+        const bool packed = p >= 0 && pack_ok[std::size_t(p)];
+        const TextureRef* refs[BoundMaterial::kMaps] = {&m.base_color, packed ? &m.roughness : &m.metallic_roughness,
+                                                        &m.roughness, &m.metallic, &m.normal, &m.occlusion,
+                                                        &m.emissive};
+        for (int i = 0; i < BoundMaterial::kMaps; ++i) {
+            if (!refs[i]->transform.present) continue;
+            b.transformed = std::uint8_t(b.transformed | (1u << i));
+            b.xf[i] = UvTransform::of(refs[i]->transform);
+        }
         bound_.push_back(b);
     }
 }

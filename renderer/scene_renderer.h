@@ -88,7 +88,8 @@ struct SceneDraw {
 // Lines and points without normals, which glTF draws unlit: base colour
 // factor x base colour texture x vertex colour (COLOR_0) as the radiance, its
 // alpha blended (BLEND) or tested (MASK) as the PBR program does. Lines and
-// points shade with zero derivatives, so the texture's finest level is read.
+// points shade with zero derivatives, so the texture's finest level is read
+// (at the UVs through the base colour's KHR_texture_transform, if any).
 struct UnlitProgram {
     static constexpr int kVaryings = 6;  // uv, rgba
     const Mesh* mesh = nullptr;
@@ -109,7 +110,11 @@ struct UnlitProgram {
         out.kill = 0;
         for (int l = 0; l < kBlockLanes; ++l) {
             glm::vec4 c = m.base_color_factor * glm::vec4(in.var[2][l], in.var[3][l], in.var[4][l], in.var[5][l]);
-            if (material->base_color) c *= material->base_color->sample(in.var[0][l], in.var[1][l], 0.0f, 0.0f, 0.0f, 0.0f);
+            if (material->base_color) {
+                glm::vec2 uv(in.var[0][l], in.var[1][l]);
+                if (const UvTransform* x = material->transform_of(BoundMaterial::kBaseColor)) uv = x->apply(uv);
+                c *= material->base_color->sample(uv.x, uv.y, 0.0f, 0.0f, 0.0f, 0.0f);
+            }
             out.r[l] = c.r; out.g[l] = c.g; out.b[l] = c.b;
             out.a[l] = m.alpha_mode == AlphaMode::Blend ? c.a : 1.0f;
             if (m.alpha_mode == AlphaMode::Mask && !(c.a >= m.alpha_cutoff)) out.kill |= 1u << l;

@@ -261,11 +261,12 @@ void pose_scene(Scene& scene, double t, int animation) {
     for (Light& light : scene.lights) {
         if (light.source_node < 0 || std::size_t(light.source_node) >= pose.world.size()) continue;
         const glm::dmat4& world = pose.world[std::size_t(light.source_node)];
-        if (light.type == Light::Type::Directional) {
+        if (light.type != Light::Type::Point) {  // suns and spots shine along the node's -Z
             const glm::dvec3 towards = glm::dmat3(world) * glm::dvec3(0.0, 0.0, 1.0);
             const double len = glm::length(towards);
             if (len > 0.0 && std::isfinite(len)) light.direction = glm::vec3(towards / len);
-        } else {
+        }
+        if (light.type != Light::Type::Directional) {  // points and spots sit at its origin
             const glm::vec3 p(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
             if (finite3(p)) light.position = p;
         }

@@ -248,11 +248,13 @@ TopLevel check_json(const char* s, std::size_t n, const std::string& path) {
 // Others it uses optionally are ignored with a warning where they appear.
 bool implemented_extension(const std::string& ext) {
     static const char* const kImplemented[] = {
-        "KHR_lights_punctual",              // spot lights drawn as point lights, with a warning
+        "KHR_lights_punctual",
         "KHR_materials_emissive_strength",
         "KHR_materials_ior",
         "KHR_materials_pbrSpecularGlossiness",  // converted to metal-rough at load
+        "KHR_materials_unlit",
         "KHR_mesh_quantization",
+        "KHR_texture_transform",
     };
     for (const char* e : kImplemented)
         if (ext == e) return true;
@@ -746,16 +748,19 @@ private:
             warn(what + ": texture " + std::to_string(index) + " out of range, ignored");
             return ref;
         }
+        // KHR_texture_transform's texCoord overrides the textureInfo's (when it is a set prast reads).
+        const auto xt = extensions.find("KHR_texture_transform");
+        const int override_set = xt != extensions.end() ? texcoord_override(xt->second) : -1;
+        if (override_set >= 0) texcoord = override_set;
         // tinygltf keeps the low 32 bits: a set it reads as 1 is taken only when the file says 1.
-        if (texcoord < 0 || texcoord >= kMaxUvSets ||
-            (texcoord != 0 && file_texcoord(material, parent, key, texcoord) != std::to_string(texcoord))) {
+        if (override_set < 0 && (texcoord < 0 || texcoord >= kMaxUvSets ||
+            (texcoord != 0 && file_texcoord(material, parent, key, texcoord) != std::to_string(texcoord)))) {
             warn(what + " uses TEXCOORD_" + file_texcoord(material, parent, key, texcoord) +
                  " (only TEXCOORD_0 and TEXCOORD_1 are supported), ignored");
             return ref;
         }
         ref.texcoord = texcoord;
-        if (extensions.count("KHR_texture_transform"))
-            warn(what + ": KHR_texture_transform ignored");
+        if (xt != extensions.end()) texture_transform(xt->second, what, ref);
         const tinygltf::Texture& tex = model_.textures[std::size_t(index)];
         if (tex.source < 0 || std::size_t(tex.source) >= model_.images.size()) {
             warn(what + ": texture " + std::to_string(index) + " has no usable image source, ignored");
@@ -780,6 +785,51 @@ private:
             }
         }
         return ref;
+    }
+
+    // ---- KHR_texture_transform
+
+    // The extension's texCoord when it is a set prast reads (0 .. kMaxUvSets - 1), else -1.
+    static int texcoord_override(const tinygltf::Value& v) {
+        if (!v.IsObject()) return -1;
+        const tinygltf::Value& tc = v.Get("texCoord");
+        const double d = tc.IsNumber() ? tc.GetNumberAsDouble() : -1.0;
+        return d >= 0.0 && d < double(kMaxUvSets) && d == std::floor(d) ? int(d) : -1;
+    }
+
+    // A textureInfo's transform into ref: offset, rotation and scale (each
+    // finite, else one warning and its default), and the texCoord override
+    // (0 .. kMaxUvSets - 1, else one warning and the textureInfo's set). An
+    // identity transform is no transform (the same bytes as without it).
+    void texture_transform(const tinygltf::Value& v, const std::string& what_texture, TextureRef& ref) {
+        const std::string what = what_texture + " KHR_texture_transform";
+        if (!v.IsObject()) {
+            warn(what + ": not an object, ignored");
+            return;
+        }
+        const auto in_float = [](double d) { return std::isfinite(d) && std::fabs(d) <= 3.0e38; };
+        const auto pair = [&](const char* key, glm::vec2 fallback) {
+            const tinygltf::Value& x = v.Get(key);
+            if (x.Type() == tinygltf::NULL_TYPE) return fallback;
+            if (x.IsArray() && x.ArrayLen() == 2 && x.Get(0).IsNumber() && x.Get(1).IsNumber() &&
+                in_float(x.Get(0).GetNumberAsDouble()) && in_float(x.Get(1).GetNumberAsDouble()))
+                return glm::vec2(float(x.Get(0).GetNumberAsDouble()), float(x.Get(1).GetNumberAsDouble()));
+            warn(what + ": bad " + key + " (not two finite numbers), [" + std::to_string(int(fallback.x)) + ", " +
+                 std::to_string(int(fallback.y)) + "] used");
+            return fallback;
+        };
+        TextureTransform t;
+        t.offset = pair("offset", glm::vec2(0.0f));
+        t.scale = pair("scale", glm::vec2(1.0f));
+        const tinygltf::Value& r = v.Get("rotation");
+        if (r.Type() != tinygltf::NULL_TYPE) {
+            if (r.IsNumber() && in_float(r.GetNumberAsDouble())) t.rotation = float(r.GetNumberAsDouble());
+            else warn(what + ": bad rotation (not a finite number), 0 used");
+        }
+        if (v.Get("texCoord").Type() != tinygltf::NULL_TYPE && texcoord_override(v) < 0)
+            warn(what + ": texCoord override not 0 or 1, TEXCOORD_" + std::to_string(ref.texcoord) + " used");
+        t.present = t.offset != glm::vec2(0.0f) || t.rotation != 0.0f || t.scale != glm::vec2(1.0f);
+        ref.transform = t;
     }
 
     // ---- Samplers
@@ -909,6 +959,9 @@ private:
                     const double ior = value.Get("ior").GetNumberAsDouble();
                     if (std::isfinite(ior) && ior >= 1.0) m.ior = float(ior);
                 }
+            } else if (name == "KHR_materials_unlit") {
+                // A flag: its object's members (none are defined) are not read.
+                m.unlit = true;
             } else if (name != "KHR_materials_pbrSpecularGlossiness") {
                 warn(what + ": extension " + cut(name) + " ignored");
             }
@@ -1463,20 +1516,66 @@ private:
             }
             light.type = Light::Type::Directional;
             light.direction = glm::vec3(towards / len);
+            if (gl.range != 0.0) warn(what + ": range of directional light " + std::to_string(li) + " ignored");
         } else if (gl.type == "point" || gl.type == "spot") {
-            if (gl.type == "spot") warn_once("spot lights are drawn as point lights");
-            light.type = Light::Type::Point;
+            light.type = gl.type == "spot" ? Light::Type::Spot : Light::Type::Point;
             light.position = glm::vec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
             if (!std::isfinite(light.position.x) || !std::isfinite(light.position.y) ||
                 !std::isfinite(light.position.z)) {
-                warn(what + ": point light with a non-finite position, ignored");
+                warn(what + ": " + gl.type + " light with a non-finite position, ignored");
                 return;
+            }
+            // range: > 0 a cut-off; absent (tinygltf's 0) infinite; anything else warned, infinite.
+            if (gl.range != 0.0) {
+                if (std::isfinite(gl.range) && gl.range > 0.0 && gl.range <= 3.0e38) light.range = float(gl.range);
+                else warn(what + ": light " + std::to_string(li) + " range is not a positive number, infinite used");
+            }
+            if (light.type == Light::Type::Spot) {
+                // It shines along its node's -Z; we store the way back to it, as for directional lights.
+                const glm::dvec3 towards = glm::dmat3(world) * glm::dvec3(0.0, 0.0, 1.0);
+                const double len = glm::length(towards);
+                if (!(len > 0.0) || !std::isfinite(len)) {
+                    warn(what + ": spot light with a degenerate transform, ignored");
+                    return;
+                }
+                light.direction = glm::vec3(towards / len);
+                spot_angles(gl.spot.innerConeAngle, gl.spot.outerConeAngle, what, li, light);
             }
         } else {
             warn(what + ": light type '" + cut(gl.type) + "' unknown, ignored");
             return;
         }
         scene_.lights.push_back(light);
+    }
+
+    // The spec's 0 <= inner < outer <= pi / 2. A non-finite angle is its
+    // default (inner 0, outer pi / 4); outer is clamped to (0, pi / 2]; an
+    // inner angle not below outer becomes 0 (the spec's fallback for one
+    // angle); each with one warning.
+    void spot_angles(double inner, double outer, const std::string& what, int li, Light& light) {
+        const std::string name = what + ": spot light " + std::to_string(li);
+        constexpr double kHalfPi = 1.5707963267948966, kDefaultOuter = 0.7853981633974483;
+        if (!std::isfinite(inner)) {
+            warn(name + " innerConeAngle is not a number, 0 used");
+            inner = 0.0;
+        }
+        if (!std::isfinite(outer)) {
+            warn(name + " outerConeAngle is not a number, pi/4 used");
+            outer = kDefaultOuter;
+        }
+        if (outer > kHalfPi) {
+            warn(name + " outerConeAngle above pi/2, pi/2 used");
+            outer = kHalfPi;
+        } else if (!(outer > 0.0)) {
+            warn(name + " outerConeAngle not above 0, pi/4 used");
+            outer = kDefaultOuter;
+        }
+        if (inner < 0.0 || !(inner < outer)) {
+            warn(name + " innerConeAngle not in [0, outerConeAngle), 0 used");
+            inner = 0.0;
+        }
+        light.inner_cone = float(inner);
+        light.outer_cone = float(outer);
     }
 
     const std::string& path_;

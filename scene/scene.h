@@ -46,13 +46,27 @@ enum class MinFilter {
 // The UV sets a mesh carries: TEXCOORD_0 (Mesh::uvs) and TEXCOORD_1 (Mesh::uvs1).
 constexpr int kMaxUvSets = 2;
 
+// KHR_texture_transform on one texture reference: uv' = T R S uv, T the
+// offset, S the scale and R the rotation by `rotation` radians, counter-
+// clockwise in UV space (u right, v down; docs/shading.md has the matrix).
+struct TextureTransform {
+    bool present = false;        // false: the UVs as they are, no float operation added
+    glm::vec2 offset{0.0f};
+    float rotation = 0.0f;
+    glm::vec2 scale{1.0f};
+    bool operator==(const TextureTransform& o) const {
+        return present == o.present && offset == o.offset && rotation == o.rotation && scale == o.scale;
+    }
+};
+
 struct TextureRef {
     int image = -1;              // index into Scene::images; -1 = none
     Wrap wrap_s = Wrap::Repeat;  // the texture's own sampler: two textures of
     Wrap wrap_t = Wrap::Repeat;  // one image may sample it differently
     Filter mag_filter = Filter::Linear;
     MinFilter min_filter = MinFilter::LinearMipmapLinear;
-    int texcoord = 0;            // UV set, 0 .. kMaxUvSets - 1
+    int texcoord = 0;            // UV set, 0 .. kMaxUvSets - 1 (the transform's override applied)
+    TextureTransform transform;
     bool valid() const { return image >= 0; }
 };
 
@@ -84,6 +98,9 @@ struct Material {
     float alpha_cutoff = 0.5f;
     bool double_sided = false;
     Conductor conductor = Conductor::None;
+    // KHR_materials_unlit: the colour is the base colour term (factor x
+    // texture x vertex colour), no light, environment or emissive.
+    bool unlit = false;
 };
 
 struct Mesh {
@@ -111,12 +128,16 @@ struct Mesh {
 };
 
 struct Light {
-    enum class Type { Directional, Point };
+    enum class Type { Directional, Point, Spot };
     Type type = Type::Directional;
-    glm::vec3 direction{0.0f, 1.0f, 0.0f}; // directional: unit vector TOWARDS the light
-    glm::vec3 position{0.0f};              // point
+    // Directional and spot: unit vector TOWARDS the light (a spot shines along -direction).
+    glm::vec3 direction{0.0f, 1.0f, 0.0f};
+    glm::vec3 position{0.0f};              // point and spot
     glm::vec3 color{1.0f};
-    float intensity = 1.0f;                // radiance = color * intensity (/ d^2 for points)
+    float intensity = 1.0f;                // radiance = color * intensity (/ d^2 for points and spots)
+    float range = 0.0f;                    // point and spot: > 0 a cut-off distance, 0 infinite
+    float inner_cone = 0.0f;               // spot: radians from the axis, 0 <= inner < outer <= pi/2
+    float outer_cone = 0.78539816f;
     int source_node = -1;                  // the glTF node that places it (posed by scene/animation.h)
 };
 

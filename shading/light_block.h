@@ -32,6 +32,7 @@ struct MaterialBlock {
     alignas(64) float er[N], eg[N], eb[N];        // emissive
     alignas(64) float alpha[N];                   // base colour alpha (BLEND's coverage; 1 otherwise)
     float ior = 1.5f;                             // per material, uniform
+    bool unlit = false;                           // KHR_materials_unlit: the albedo is the radiance
 };
 
 struct RadianceBlock {
@@ -108,7 +109,8 @@ inline void energy_lanes(const MaterialBlock& __restrict m, const ViewLanes& __r
 
 // One light's contribution f * radiance * n.l, added to out, for the first N
 // lanes (the fragment program packs the live lanes of a sparse block first).
-template <bool Point, bool Gltf, bool Energy, int N = kBlockLanes>
+// Shaped: a point light with a spot cone or a range (light_falloff()).
+template <bool Point, bool Gltf, bool Energy, bool Shaped, int N = kBlockLanes>
 inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L, const ViewLanes& __restrict w,
                         const EnergyLanes& __restrict e, RadianceBlock& __restrict out) {
     const float* __restrict vx = w.vx;
@@ -125,6 +127,9 @@ inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L
     const float Lpx = L.position.x, Lpy = L.position.y, Lpz = L.position.z;
     const float Ldx = L.direction.x, Ldy = L.direction.y, Ldz = L.direction.z;
     const float Lr = L.radiance.x, Lg = L.radiance.y, Lb = L.radiance.z;
+    const bool range_on = L.range_inv2 > 0.0f, spot_on = L.spot;
+    const float range_inv2 = L.range_inv2, cone_scale = L.cone_scale, cone_offset = L.cone_offset;
+    (void)range_on; (void)spot_on; (void)range_inv2; (void)cone_scale; (void)cone_offset;
     // Shadow: light_visibility() per lane, 1 without a map.
     alignas(64) float vis[N];
     if (L.shadow) shadow_visibility_lanes<N>(*L.shadow, m.Px, m.Py, m.Pz, m.Gx, m.Gy, m.Gz, L.direction, vis);
@@ -144,6 +149,21 @@ inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L
             Rr = ok ? Lr / dd : 0.0f;
             Rg = ok ? Lg / dd : 0.0f;
             Rb = ok ? Lb / dd : 0.0f;
+            if constexpr (Shaped) {  // light_falloff(): the range window, then the spot cone
+                float att = 1.0f;
+                if (range_on) {
+                    const float q = d2 * range_inv2;
+                    const float wnd = 1.0f - q * q;
+                    att = wnd < 0.0f ? 0.0f : (wnd > 1.0f ? 1.0f : wnd);
+                }
+                if (spot_on) {
+                    const float cd = lx * Ldx + ly * Ldy + lz * Ldz;
+                    float a = cd * cone_scale + cone_offset;
+                    a = a < 0.0f ? 0.0f : (a > 1.0f ? 1.0f : a);
+                    att = att * (a * a);
+                }
+                Rr *= att; Rg *= att; Rb *= att;
+            }
         }
         Rr *= vis[l]; Rg *= vis[l]; Rb *= vis[l];
         // Cosines and h.
@@ -313,6 +333,14 @@ template <int N = kBlockLanes>
 inline void shade_block_lanes(const MaterialBlock& __restrict m, const ShadingContext& ctx,
                               RadianceBlock& __restrict out) {
     static_assert(N % 4 == 0 && N <= kBlockLanes, "whole vectors of lanes");
+    if (m.unlit) {  // KHR_materials_unlit (shade_surface()): the base colour term alone
+        for (int l = 0; l < N; ++l) {
+            out.r[l] = m.ar[l];
+            out.g[l] = m.ag[l];
+            out.b[l] = m.ab[l];
+        }
+        return;
+    }
     const bool gltf = ctx.model == BrdfModel::Gltf;
     ViewLanes w;
     const float f0 = f0_from_ior(m.ior);
@@ -359,19 +387,25 @@ inline void shade_block_lanes(const MaterialBlock& __restrict m, const ShadingCo
     if (energy) energy_lanes<N>(m, w, *ctx.dfg_light, e);
     for (const ShadingLight& L : ctx.lights) {
         if (energy) {
-            if (L.point) {
-                if (gltf) light_lanes<true, true, true, N>(m, L, w, e, out);
-                else light_lanes<true, false, true, N>(m, L, w, e, out);
+            if (L.shaped()) {
+                if (gltf) light_lanes<true, true, true, true, N>(m, L, w, e, out);
+                else light_lanes<true, false, true, true, N>(m, L, w, e, out);
+            } else if (L.point) {
+                if (gltf) light_lanes<true, true, true, false, N>(m, L, w, e, out);
+                else light_lanes<true, false, true, false, N>(m, L, w, e, out);
             } else {
-                if (gltf) light_lanes<false, true, true, N>(m, L, w, e, out);
-                else light_lanes<false, false, true, N>(m, L, w, e, out);
+                if (gltf) light_lanes<false, true, true, false, N>(m, L, w, e, out);
+                else light_lanes<false, false, true, false, N>(m, L, w, e, out);
             }
+        } else if (L.shaped()) {
+            if (gltf) light_lanes<true, true, false, true, N>(m, L, w, e, out);
+            else light_lanes<true, false, false, true, N>(m, L, w, e, out);
         } else if (L.point) {
-            if (gltf) light_lanes<true, true, false, N>(m, L, w, e, out);
-            else light_lanes<true, false, false, N>(m, L, w, e, out);
+            if (gltf) light_lanes<true, true, false, false, N>(m, L, w, e, out);
+            else light_lanes<true, false, false, false, N>(m, L, w, e, out);
         } else {
-            if (gltf) light_lanes<false, true, false, N>(m, L, w, e, out);
-            else light_lanes<false, false, false, N>(m, L, w, e, out);
+            if (gltf) light_lanes<false, true, false, false, N>(m, L, w, e, out);
+            else light_lanes<false, false, false, false, N>(m, L, w, e, out);
         }
     }
     if (ctx.env) {

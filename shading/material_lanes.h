@@ -81,8 +81,13 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     // indices (sample_lanes.h), prepared and read together; a texture bound
     // twice (glTF occlusion in R of the metal-roughness map) is read once.
     enum { kBase, kMetalRough, kRough, kMetal, kNormal, kOcclusion, kEmissive, kMaps };
-    const Texture* maps[kMaps] = {bm.base_color, bm.metallic_roughness, bm.roughness, bm.metallic,
-                                  bm.normal, bm.occlusion, bm.emissive};
+    static_assert(int(kMaps) == int(BoundMaterial::kMaps) && int(kEmissive) == int(BoundMaterial::kEmissive),
+                  "the maps in BoundMaterial's order");
+    const bool unlit = m.unlit;  // KHR_materials_unlit: the base colour alone is read
+    const Texture* maps[kMaps] = {bm.base_color, unlit ? nullptr : bm.metallic_roughness,
+                                  unlit ? nullptr : bm.roughness, unlit ? nullptr : bm.metallic,
+                                  unlit ? nullptr : bm.normal, unlit ? nullptr : bm.occlusion,
+                                  unlit ? nullptr : bm.emissive};
     const bool mask_mode = m.alpha_mode == AlphaMode::Mask;
     const bool alpha_read = mask_mode || m.alpha_mode == AlphaMode::Blend;
     const std::uint8_t used[kMaps] = {std::uint8_t(alpha_read ? 0xF : 0x7), 0x6, 0x1, 0x1, 0x7, 0x1, 0x7};
@@ -90,12 +95,23 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
     std::uint64_t uv_word = 0;
     static_assert(sizeof(bm.uv) <= sizeof(uv_word), "the UV sets fit one word");
     std::memcpy(&uv_word, &bm.uv, sizeof(bm.uv));
-    const bool multi_uv = uv_word != 0;
-    std::uint8_t set[kMaps] = {};
+    // Maps are keyed by UV set and texture transform: key = set * 8 + 1 +
+    // the first map with an equal transform, or set * 8 without one. All 0
+    // unless a map reads another set or has a transform.
+    const std::uint8_t transformed = bm.transformed;
+    const bool multi_uv = uv_word != 0 || transformed != 0;
+    std::uint8_t set[kMaps] = {}, key[kMaps] = {};
     if (multi_uv) {
         set[kBase] = bm.uv.base_color; set[kMetalRough] = bm.uv.metallic_roughness; set[kRough] = bm.uv.roughness;
         set[kMetal] = bm.uv.metallic; set[kNormal] = bm.uv.normal; set[kOcclusion] = bm.uv.occlusion;
         set[kEmissive] = bm.uv.emissive;
+        for (int i = 0; i < kMaps; ++i) {
+            key[i] = std::uint8_t(set[i] * 8);
+            if (!((transformed >> i) & 1u)) continue;
+            int j = 0;
+            while (!((transformed >> j) & 1u) || !(bm.xf[j] == bm.xf[i])) ++j;
+            key[i] = std::uint8_t(key[i] + 1 + j);
+        }
     }
     TexelLanes texel[kMaps];
     const TexelLanes* tl[kMaps];
@@ -114,25 +130,25 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         const Texture* group_tex[kMaps][kMaps];
         TexelLanes* group_out[kMaps][kMaps];
         std::uint8_t group_used[kMaps][kMaps];
-        std::uint8_t group_set[kMaps];
+        std::uint8_t group_key[kMaps];
         int group_size[kMaps];
         for (int i = 0; i < kMaps; ++i) {
             if (!maps[i]) continue;
             int j = 0;
-            while (j < i && (maps[j] != maps[i] || (multi_uv && set[j] != set[i]))) ++j;
+            while (j < i && (maps[j] != maps[i] || (multi_uv && key[j] != key[i]))) ++j;
             if (j < i) {  // the same texture at the same uv again: share its lookup
                 tl[i] = tl[j];
                 for (int g = 0; g < groups; ++g)
                     for (int k = 0; k < group_size[g]; ++k)
-                        if (group_tex[g][k] == maps[i] && (!multi_uv || group_set[g] == set[i]))
+                        if (group_tex[g][k] == maps[i] && (!multi_uv || group_key[g] == key[i]))
                             group_used[g][k] |= used[i];
                 continue;
             }
             int g = 0;
-            while (g < groups && !((!multi_uv || group_set[g] == set[i]) && same_sampling_layout(*group_tex[g][0], *maps[i])))
+            while (g < groups && !((!multi_uv || group_key[g] == key[i]) && same_sampling_layout(*group_tex[g][0], *maps[i])))
                 ++g;
             if (g == groups) {
-                group_set[groups] = set[i];
+                group_key[groups] = key[i];
                 group_size[groups++] = 0;
             }
             group_tex[g][group_size[g]] = maps[i];
@@ -142,18 +158,37 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         for (int g = 0; g < groups; ++g) {
             // material_lods(): one lambda per quad with a live lane.
             const Texture& first = *group_tex[g][0];
-            const int uv_set = group_set[g];
+            const int uv_set = group_key[g] / 8;
             const float* dudx = uv_set ? s.dudx_more[uv_set - 1] : s.dudx;
             const float* dvdx = uv_set ? s.dvdx_more[uv_set - 1] : s.dvdx;
             const float* dudy = uv_set ? s.dudy_more[uv_set - 1] : s.dudy;
             const float* dvdy = uv_set ? s.dvdy_more[uv_set - 1] : s.dvdy;
+            const float* u = s.u_of(uv_set);
+            const float* v = s.v_of(uv_set);
             float lambda[kMaxQuadSlots];
-            for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
-                const int q = __builtin_ctz(qs);
-                lambda[q] = first.lod(dudx[q], dvdx[q], dudy[q], dvdy[q]);
+            alignas(64) float tu[N], tv[N];
+            if (group_key[g] % 8) {  // KHR_texture_transform: UVs and derivatives as UvTransform's
+                const UvTransform& x = bm.xf[group_key[g] % 8 - 1];
+                for (int l = 0; l < N; ++l) {
+                    tu[l] = x.m00 * u[l] + x.m01 * v[l] + x.ox;
+                    tv[l] = x.m10 * u[l] + x.m11 * v[l] + x.oy;
+                }
+                for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
+                    const int q = __builtin_ctz(qs);
+                    const float ux = x.m00 * dudx[q] + x.m01 * dvdx[q], vx = x.m10 * dudx[q] + x.m11 * dvdx[q];
+                    const float uy = x.m00 * dudy[q] + x.m01 * dvdy[q], vy = x.m10 * dudy[q] + x.m11 * dvdy[q];
+                    lambda[q] = first.lod(ux, vx, uy, vy);
+                }
+                u = tu;
+                v = tv;
+            } else {
+                for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
+                    const int q = __builtin_ctz(qs);
+                    lambda[q] = first.lod(dudx[q], dvdx[q], dudy[q], dvdy[q]);
+                }
             }
             TrilinearLanes at;
-            prepare_trilinear_lanes<N>(first, s.u_of(uv_set), s.v_of(uv_set), lambda, s.quad, live, at);
+            prepare_trilinear_lanes<N>(first, u, v, lambda, s.quad, live, at);
             fetch_trilinear_lanes<N>(group_tex[g], group_size[g], at, group_out[g], group_used[g]);
         }
     }
@@ -184,6 +219,7 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
             for (int l = 0; l < N; ++l) alpha[l] *= s.Ca[l];
     }
     mb.ior = m.ior;
+    mb.unlit = unlit;
 
     // Metal and roughness: glTF packs them in G and B; OBJ has separate maps (R).
     alignas(64) float metallic[N], roughness[N];

@@ -4,6 +4,7 @@
 // these, so an explained pixel shows the numbers that made it.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -19,6 +20,33 @@
 #include "shading/texture.h"
 
 namespace prast {
+
+// A texture reference's KHR_texture_transform as the shading applies it:
+// uv' = (m00 u + m01 v) + ox, (m10 u + m11 v) + oy, and the derivatives by
+// the linear part alone. The lane code performs the same operations.
+struct UvTransform {
+    float m00 = 1.0f, m01 = 0.0f, m10 = 0.0f, m11 = 1.0f, ox = 0.0f, oy = 0.0f;
+
+    // T R S of the extension, R turning counter-clockwise in UV space (u
+    // right, v down): the matrix the extension's examples and sample model
+    // use (docs/shading.md). Products in double, rounded once.
+    static UvTransform of(const TextureTransform& t) {
+        const double c = std::cos(double(t.rotation)), s = std::sin(double(t.rotation));
+        UvTransform x;
+        x.m00 = float(c * double(t.scale.x));
+        x.m01 = float(s * double(t.scale.y));
+        x.m10 = float(-s * double(t.scale.x));
+        x.m11 = float(c * double(t.scale.y));
+        x.ox = t.offset.x;
+        x.oy = t.offset.y;
+        return x;
+    }
+    glm::vec2 apply(glm::vec2 uv) const { return {m00 * uv.x + m01 * uv.y + ox, m10 * uv.x + m11 * uv.y + oy}; }
+    glm::vec2 linear(glm::vec2 d) const { return {m00 * d.x + m01 * d.y, m10 * d.x + m11 * d.y}; }
+    bool operator==(const UvTransform& o) const {
+        return m00 == o.m00 && m01 == o.m01 && m10 == o.m10 && m11 == o.m11 && ox == o.ox && oy == o.oy;
+    }
+};
 
 // A material with its textures resolved (null = no map).
 struct BoundMaterial {
@@ -36,6 +64,13 @@ struct BoundMaterial {
         std::uint8_t normal = 0, occlusion = 0, emissive = 0;
     };
     UvSets uv = {};
+    // The maps in this order (kBaseColor ..), for the transforms below.
+    enum Map { kBaseColor, kMetalRough, kRoughness, kMetallic, kNormal, kOcclusion, kEmissive, kMaps };
+    // Bit i set: map i's UVs go through xf[i] (KHR_texture_transform). 0 on
+    // the usual path, which then performs no operation for it.
+    std::uint8_t transformed = 0;
+    UvTransform xf[kMaps] = {};
+    const UvTransform* transform_of(int map) const { return (transformed >> map) & 1u ? &xf[map] : nullptr; }
     // True when a bound map reads a UV set other than TEXCOORD_0.
     bool reads_extra_uv_sets() const {
         return (base_color && uv.base_color) || (metallic_roughness && uv.metallic_roughness) ||
@@ -76,15 +111,34 @@ struct MaterialSample {
     Conductor conductor = Conductor::None;
     glm::vec3 N{0.0f, 0.0f, 1.0f};  // shading normal (normal-mapped, unit, facing flipped)
     glm::vec3 N_geom{0.0f, 0.0f, 1.0f}; // unit interpolated normal (facing flipped)
+    bool unlit = false;  // KHR_materials_unlit: shade_surface() gives the albedo (base colour term)
 };
 
 struct ShadingLight {
-    bool point = false;
-    glm::vec3 direction{0.0f, 1.0f, 0.0f};  // directional: towards the light
-    glm::vec3 position{0.0f};               // point
+    bool point = false;                     // point and spot lights (the cube shadow map)
+    glm::vec3 direction{0.0f, 1.0f, 0.0f};  // directional and spot: towards the light (unit)
+    glm::vec3 position{0.0f};               // point and spot
     glm::vec3 radiance{1.0f};               // colour * intensity
     const ShadowMap* shadow = nullptr;      // its shadow map this frame (shadow_pass.h), or none
+    // KHR_lights_punctual spot cone: a = clamp(dot(l, direction) cone_scale +
+    // cone_offset, 0, 1), times a^2 (spot_cone() makes the two numbers).
+    bool spot = false;
+    float cone_scale = 0.0f, cone_offset = 1.0f;
+    // The range window max(1 - (d^2 range_inv2)^2, 0) of a point or spot
+    // light; 0 = no range (infinite).
+    float range_inv2 = 0.0f;
+    // Either of the two: light_at() multiplies the radiance by light_falloff().
+    bool shaped() const { return point && (spot || range_inv2 > 0.0f); }
 };
+
+// The spot cone's numbers of KHR_lights_punctual's reference code:
+// scale = 1 / max(0.001, cos(inner) - cos(outer)), offset = -cos(outer) scale.
+inline void spot_cone(float inner, float outer, float& scale, float& offset) {
+    const double ci = std::cos(double(inner)), co = std::cos(double(outer));
+    const double sc = 1.0 / std::max(0.001, ci - co);
+    scale = float(sc);
+    offset = float(-co * sc);
+}
 
 // How an environment map lights a surface: the split sum (the image) or the
 // reflectance integral itself (render --ibl reference).
@@ -109,6 +163,27 @@ struct ShadingContext {
 };
 
 
+// The range window and the spot cone of a shaped light at unit direction l
+// (towards the light) and squared distance d2: window = clamp(1 - (d2
+// range_inv2)^2, 0, 1) (KHR_lights_punctual's 1 - (d / range)^4), a =
+// clamp(l.direction scale + offset, 0, 1), returned as window * (a * a).
+// The lane code (light_block.h) performs the same operations.
+inline float light_falloff(const ShadingLight& L, const glm::vec3& l, float d2) {
+    float att = 1.0f;
+    if (L.range_inv2 > 0.0f) {
+        const float q = d2 * L.range_inv2;
+        const float w = 1.0f - q * q;
+        att = w < 0.0f ? 0.0f : (w > 1.0f ? 1.0f : w);
+    }
+    if (L.spot) {
+        const float cd = l.x * L.direction.x + l.y * L.direction.y + l.z * L.direction.z;
+        float a = cd * L.cone_scale + L.cone_offset;
+        a = a < 0.0f ? 0.0f : (a > 1.0f ? 1.0f : a);
+        att = att * (a * a);
+    }
+    return att;
+}
+
 // Light direction (towards the light) and incoming radiance at P.
 inline void light_at(const ShadingLight& L, const glm::vec3& P, glm::vec3& l, glm::vec3& radiance) {
     if (!L.point) {
@@ -121,6 +196,7 @@ inline void light_at(const ShadingLight& L, const glm::vec3& P, glm::vec3& l, gl
     if (!(d2 > 1e-12f)) { l = glm::vec3(0.0f, 0.0f, 1.0f); radiance = glm::vec3(0.0f); return; }
     l = d / std::sqrt(d2);
     radiance = L.radiance / d2;
+    if (L.shaped()) radiance *= light_falloff(L, l, d2);
 }
 
 // The fraction of the light reaching P (geometric normal Ng) past the shadow
@@ -153,22 +229,28 @@ inline MaterialLods material_lods(const BoundMaterial& bm, glm::vec2 duv_dx, glm
     return l;
 }
 
-// Each map with the derivatives of the UV set it reads.
+// Each map with the derivatives of the UV set it reads, through its
+// transform's linear part when it has one.
 inline MaterialLods material_lods(const BoundMaterial& bm, const SurfacePoint& sp) {
-    if (!bm.reads_extra_uv_sets()) return material_lods(bm, sp.duv_dx, sp.duv_dy);
+    if (!bm.reads_extra_uv_sets() && !bm.transformed) return material_lods(bm, sp.duv_dx, sp.duv_dy);
     MaterialLods l;
-    auto lod = [&](const Texture* t, int set) {
+    auto lod = [&](const Texture* t, int set, int map) {
         if (!t) return 0.0f;
-        const glm::vec2 dx = sp.duv_dx_of(set), dy = sp.duv_dy_of(set);
+        glm::vec2 dx = sp.duv_dx_of(set), dy = sp.duv_dy_of(set);
+        if (const UvTransform* x = bm.transform_of(map)) {
+            dx = x->linear(dx);
+            dy = x->linear(dy);
+        }
         return t->lod(dx.x, dx.y, dy.x, dy.y);
     };
-    l.base_color = lod(bm.base_color, bm.uv.base_color);
-    l.metallic_roughness = lod(bm.metallic_roughness, bm.uv.metallic_roughness);
-    l.roughness = lod(bm.roughness, bm.uv.roughness);
-    l.metallic = lod(bm.metallic, bm.uv.metallic);
-    l.normal = lod(bm.normal, bm.uv.normal);
-    l.occlusion = lod(bm.occlusion, bm.uv.occlusion);
-    l.emissive = lod(bm.emissive, bm.uv.emissive);
+    using B = BoundMaterial;
+    l.base_color = lod(bm.base_color, bm.uv.base_color, B::kBaseColor);
+    l.metallic_roughness = lod(bm.metallic_roughness, bm.uv.metallic_roughness, B::kMetalRough);
+    l.roughness = lod(bm.roughness, bm.uv.roughness, B::kRoughness);
+    l.metallic = lod(bm.metallic, bm.uv.metallic, B::kMetallic);
+    l.normal = lod(bm.normal, bm.uv.normal, B::kNormal);
+    l.occlusion = lod(bm.occlusion, bm.uv.occlusion, B::kOcclusion);
+    l.emissive = lod(bm.emissive, bm.uv.emissive, B::kEmissive);
     return l;
 }
 
@@ -181,9 +263,11 @@ inline glm::vec3 safe_normalize(const glm::vec3& v, const glm::vec3& fallback) {
     return v / std::sqrt(len2);
 }
 
-// The map's own sampler at its UV set.
-inline glm::vec4 fetch(const Texture* tex, const SurfacePoint& sp, int set, float lambda) {
-    const glm::vec2 uv = sp.uv_of(set);
+// The map's own sampler at its UV set, through its transform (map: BoundMaterial::Map).
+inline glm::vec4 fetch(const BoundMaterial& bm, int map, const Texture* tex, const SurfacePoint& sp, int set,
+                       float lambda) {
+    glm::vec2 uv = sp.uv_of(set);
+    if (const UvTransform* x = bm.transform_of(map)) uv = x->apply(uv);
     return tex->sample_lod(uv.x, uv.y, lambda);
 }
 
@@ -219,29 +303,35 @@ inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoin
     // Base colour and alpha: factor times the (already linear) texture times
     // the vertex colour (glTF's COLOR_0).
     glm::vec4 base = m.base_color_factor;
-    if (bm.base_color) base *= surface_detail::fetch(bm.base_color, sp, bm.uv.base_color, lods.base_color);
+    if (bm.base_color) base *= surface_detail::fetch(bm, BoundMaterial::kBaseColor, bm.base_color, sp, bm.uv.base_color, lods.base_color);
     if (sp.has_color) base *= sp.color;
     s.albedo = glm::vec3(base);
     s.ior = m.ior;
     s.conductor = m.conductor;
     s.alpha = base.a;
+    if (m.unlit) {  // the base colour term alone; the other maps are not read
+        s.unlit = true;
+        s.N_geom = surface_detail::safe_normalize(sp.N, glm::vec3(0.0f, 0.0f, 1.0f)) * (sp.front_facing ? 1.0f : -1.0f);
+        s.N = s.N_geom;
+        return s;
+    }
 
     // Metal and roughness: glTF packs them in G and B; OBJ has separate maps (R).
     s.metallic = m.metallic_factor;
     s.roughness = m.roughness_factor;
     if (bm.metallic_roughness) {
-        glm::vec4 mr = surface_detail::fetch(bm.metallic_roughness, sp, bm.uv.metallic_roughness, lods.metallic_roughness);
+        glm::vec4 mr = surface_detail::fetch(bm, BoundMaterial::kMetalRough, bm.metallic_roughness, sp, bm.uv.metallic_roughness, lods.metallic_roughness);
         s.roughness *= mr.g;
         s.metallic *= mr.b;
     }
-    if (bm.roughness) s.roughness *= surface_detail::fetch(bm.roughness, sp, bm.uv.roughness, lods.roughness).r;
-    if (bm.metallic) s.metallic *= surface_detail::fetch(bm.metallic, sp, bm.uv.metallic, lods.metallic).r;
+    if (bm.roughness) s.roughness *= surface_detail::fetch(bm, BoundMaterial::kRoughness, bm.roughness, sp, bm.uv.roughness, lods.roughness).r;
+    if (bm.metallic) s.metallic *= surface_detail::fetch(bm, BoundMaterial::kMetallic, bm.metallic, sp, bm.uv.metallic, lods.metallic).r;
     s.metallic = glm::clamp(s.metallic, 0.0f, 1.0f);
     s.roughness = glm::clamp(s.roughness, 0.0f, 1.0f);
 
-    if (bm.occlusion) s.occlusion = 1.0f + m.occlusion_strength * (surface_detail::fetch(bm.occlusion, sp, bm.uv.occlusion, lods.occlusion).r - 1.0f);
+    if (bm.occlusion) s.occlusion = 1.0f + m.occlusion_strength * (surface_detail::fetch(bm, BoundMaterial::kOcclusion, bm.occlusion, sp, bm.uv.occlusion, lods.occlusion).r - 1.0f);
     s.emissive = m.emissive_factor;
-    if (bm.emissive) s.emissive *= glm::vec3(surface_detail::fetch(bm.emissive, sp, bm.uv.emissive, lods.emissive));
+    if (bm.emissive) s.emissive *= glm::vec3(surface_detail::fetch(bm, BoundMaterial::kEmissive, bm.emissive, sp, bm.uv.emissive, lods.emissive));
 
     // Geometric frame; a back face of a double-sided material flips all of it.
     glm::vec3 N = surface_detail::safe_normalize(sp.N, glm::vec3(0.0f, 0.0f, 1.0f));
@@ -256,7 +346,7 @@ inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoin
         if (glm::dot(T, T) > 0.0f) {
             float w = sp.T.w < 0.0f ? -1.0f : 1.0f;
             glm::vec3 B = glm::cross(N, T) * w;
-            glm::vec4 tx = surface_detail::fetch(bm.normal, sp, bm.uv.normal, lods.normal);
+            glm::vec4 tx = surface_detail::fetch(bm, BoundMaterial::kNormal, bm.normal, sp, bm.uv.normal, lods.normal);
             glm::vec3 nt = glm::vec3(tx) * 2.0f - 1.0f;
             nt.x *= m.normal_scale;
             nt.y *= m.normal_scale;
@@ -393,9 +483,10 @@ inline glm::vec3 ibl_reference(const MaterialSample& ms, const SurfacePoint& sp,
 
 inline glm::vec3 shade_surface(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx,
                                std::vector<BrdfTerms>* terms = nullptr) {
+    if (terms) terms->clear();
+    if (ms.unlit) return ms.albedo;  // KHR_materials_unlit: no light, environment or emissive
     BrdfInputs in = brdf_inputs(ms, sp, ctx);
     glm::vec3 Lo = ms.emissive;
-    if (terms) terms->clear();
     for (const ShadingLight& L : ctx.lights) {
         glm::vec3 radiance;
         light_at(L, sp.P, in.l, radiance);

@@ -3,6 +3,7 @@
 // shows exactly the numbers the image was made of.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -40,8 +41,11 @@ const IblRig& ibl_rig() {
     return rig;
 }
 
+// shaped: also a spot light whose cone spans the lanes (inside the inner
+// cone, between the cones, outside) and a point light with a range some lanes
+// lie beyond, both at once (KHR_lights_punctual, light_falloff()).
 void check_block(BrdfModel model, std::uint32_t seed, bool with_env = false, bool energy = false,
-                 bool away = false) {
+                 bool away = false, bool shaped = false, bool unlit = false) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> uni(0.0f, 1.0f), sym(-1.0f, 1.0f);
     ShadingContext ctx;
@@ -49,6 +53,21 @@ void check_block(BrdfModel model, std::uint32_t seed, bool with_env = false, boo
     ctx.model = model;
     ctx.ambient = {0.03f, 0.04f, 0.05f};
     add_test_lights(ctx, rng);
+    if (shaped) {
+        ShadingLight spot, ranged;
+        spot.point = spot.spot = true;
+        spot.position = {sym(rng) * 0.3f, sym(rng) * 0.3f, 2.0f};
+        spot.direction = glm::normalize(glm::vec3(sym(rng) * 0.2f, sym(rng) * 0.2f, 1.0f));
+        spot.radiance = {20.0f, 18.0f, 15.0f};
+        spot_cone(0.15f + 0.1f * uni(rng), 0.45f + 0.1f * uni(rng), spot.cone_scale, spot.cone_offset);
+        spot.range_inv2 = (seed % 2) ? 1.0f / (3.0f * 3.0f) : 0.0f;  // with and without a range
+        ranged.point = true;
+        ranged.position = {sym(rng), sym(rng), 0.5f};
+        ranged.radiance = {5.0f, 6.0f, 7.0f};
+        ranged.range_inv2 = 1.0f / (1.2f * 1.2f);
+        ctx.lights.push_back(spot);
+        ctx.lights.push_back(ranged);
+    }
     const bool gltf = model == BrdfModel::Gltf;
     if (with_env) {
         ctx.env = &ibl_rig().env;
@@ -61,6 +80,7 @@ void check_block(BrdfModel model, std::uint32_t seed, bool with_env = false, boo
 
     MaterialBlock mb;
     mb.ior = 1.3f + uni(rng);
+    mb.unlit = unlit;
     for (int l = 0; l < kBlockLanes; ++l) {
         glm::vec3 n = glm::normalize(glm::vec3(sym(rng), sym(rng), sym(rng)) + glm::vec3(0, 0, 0.2f));
         mb.Px[l] = sym(rng); mb.Py[l] = sym(rng); mb.Pz[l] = sym(rng);
@@ -98,6 +118,7 @@ void check_block(BrdfModel model, std::uint32_t seed, bool with_env = false, boo
         ms.emissive = {mb.er[l], mb.eg[l], mb.eb[l]};
         ms.ior = mb.ior;
         ms.N = {mb.Nx[l], mb.Ny[l], mb.Nz[l]};
+        ms.unlit = unlit;
         SurfacePoint sp;
         sp.P = {mb.Px[l], mb.Py[l], mb.Pz[l]};
         glm::vec3 ref = shade_surface(ms, sp, ctx);
@@ -107,6 +128,11 @@ void check_block(BrdfModel model, std::uint32_t seed, bool with_env = false, boo
         CHECK(bits(rb.b[l]) == bits(ref.b));
         // Lit by the environment, a surface that faces away still reflects it.
         if (away && with_env) CHECK(ref.r + ref.g + ref.b > 0.0f);
+        if (unlit) {  // KHR_materials_unlit: the albedo itself, no light, emissive or environment
+            CHECK(bits(ref.r) == bits(mb.ar[l]));
+            CHECK(bits(ref.g) == bits(mb.ag[l]));
+            CHECK(bits(ref.b) == bits(mb.ab[l]));
+        }
     }
 }
 
@@ -163,5 +189,49 @@ TEST_CASE("16-lane --energy conserve equals the scalar path bit for bit, with an
             check_block(model, seed, false, true);
             check_block(model, seed, true, true);
         }
+}
+TEST_CASE("16-lane spot lights and light ranges equal the scalar light_falloff() bit for bit") {
+    for (BrdfModel model : {BrdfModel::Default, BrdfModel::Gltf})
+        for (std::uint32_t seed = 1; seed <= 100; ++seed) {
+            check_block(model, seed, false, false, false, true);
+            check_block(model, seed, true, false, false, true);
+            check_block(model, seed, false, true, false, true);
+            check_block(model, seed, true, true, true, true);
+        }
+}
+TEST_CASE("spot_cone() and light_falloff(): the KHR_lights_punctual reference formulas") {
+    ShadingLight L;
+    L.point = L.spot = true;
+    L.direction = {0.0f, 0.0f, 1.0f};
+    const double inner = 0.3, outer = 0.6;
+    spot_cone(float(inner), float(outer), L.cone_scale, L.cone_offset);
+    CHECK(L.cone_scale == doctest::Approx(1.0 / (std::cos(inner) - std::cos(outer))).epsilon(1e-7));
+    for (double theta = 0.0; theta < 1.5; theta += 0.01) {
+        const glm::vec3 l(float(std::sin(theta)), 0.0f, float(std::cos(theta)));
+        const double a = std::clamp((std::cos(theta) - std::cos(outer)) / (std::cos(inner) - std::cos(outer)), 0.0, 1.0);
+        const float f = light_falloff(L, l, 1.0f);
+        CHECK(std::fabs(double(f) - a * a) <= 1e-5);
+        if (theta < inner - 1e-3) CHECK(f == 1.0f);
+        if (theta > outer + 1e-3) CHECK(f == 0.0f);
+    }
+    // Equal angles: the spec's max(0.001, ...) guard, a hard edge, never a division by 0.
+    spot_cone(0.5f, 0.5f, L.cone_scale, L.cone_offset);
+    CHECK(std::isfinite(L.cone_scale));
+    CHECK(L.cone_scale == doctest::Approx(1000.0));
+    // The range window 1 - (d / range)^4, 0 beyond it.
+    ShadingLight R;
+    R.point = true;
+    R.range_inv2 = 1.0f / 4.0f;  // range 2
+    for (double d = 0.05; d < 3.0; d += 0.05) {
+        const double want = std::max(0.0, 1.0 - std::pow(d / 2.0, 4.0));
+        CHECK(std::fabs(double(light_falloff(R, {0.0f, 0.0f, 1.0f}, float(d * d))) - want) <= 1e-5);
+        if (d > 2.0 + 1e-6) CHECK(light_falloff(R, {0.0f, 0.0f, 1.0f}, float(d * d)) == 0.0f);
+    }
+}
+TEST_CASE("an unlit material (KHR_materials_unlit): lanes and scalar give the albedo, lights and environment aside") {
+    for (std::uint32_t seed = 1; seed <= 20; ++seed) {
+        check_block(BrdfModel::Default, seed, false, false, false, true, true);
+        check_block(BrdfModel::Gltf, seed, true, true, false, true, true);
+    }
 }
 }

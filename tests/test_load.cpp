@@ -324,10 +324,10 @@ void check_quad_scene(const Scene& s) {
     check_vec(s.lights[0].direction, {0, 1, 0}); // -Z turned down by R_x(-90): towards the light is up
     check_vec(s.lights[0].color, {1, 0.9f, 0.8f});
     CHECK(s.lights[0].intensity == doctest::Approx(3));
-    CHECK(s.lights[1].type == Light::Type::Point); // a spot light, with a warning
+    CHECK(s.lights[1].type == Light::Type::Spot);
     check_vec(s.lights[1].position, {10, 5, 0});
     CHECK(s.lights[1].intensity == doctest::Approx(20));
-    CHECK(any_warning(s, "spot"));
+    CHECK(!any_warning(s, "spot"));
 }
 
 // ---- The small OBJ used by several tests
