@@ -1,10 +1,12 @@
 // step: the stepper. Takes render's scene, camera, light and
 // view-transform flags, records one frame with the prast_stepper library and
-// explains it: commands on standard input (a prompt only on a terminal),
+// explains it: commands on standard input (on a terminal a prompt with line
+// editing and history, through libedit),
 // --out DIR (every stage as a PNG and an index.html), or --serve (a local web
 // page). Errors are one line on stderr, "step: ...": exit code 2 for usage,
 // 1 for bad files (and for a session in which a command failed).
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <iostream>
@@ -13,6 +15,8 @@
 #include <vector>
 
 #include <unistd.h>
+
+#include <editline/readline.h>
 
 #include "apps/cli/step_flags.h"
 #include "apps/frame_request.h"
@@ -112,10 +116,15 @@ int run(int argc, char** argv) {
     std::string line;
     for (;;) {
         if (tty) {
-            std::fputs("step> ", stdout);
-            std::fflush(stdout);
+            // libedit: the arrow keys edit the line and walk the history.
+            char* got = readline("step> ");
+            if (!got) break;
+            line = got;
+            std::free(got);
+            if (line.find_first_not_of(" \t") != std::string::npos) add_history(line.c_str());
+        } else if (!std::getline(std::cin, line)) {
+            break;
         }
-        if (!std::getline(std::cin, line)) break;
         const Reply r = session.run(line);
         std::fputs(r.text.c_str(), stdout);
         std::fflush(stdout);

@@ -16,7 +16,7 @@ PACKAGES="
   libcli11-dev
   zlib1g-dev
   libpng-dev
-  libcpp-httplib-dev
+  libedit-dev
   pkg-config
 "
 missing=""

@@ -6,12 +6,12 @@
 #include <cstdio>
 #include <cstring>
 #include <sstream>
-#include <unordered_map>
 
 #include "scene/messages.h"
 #include "shading/color.h"
 #include "shading/tonemap.h"
 #include "stepper/format.h"
+#include "stepper/views.h"
 #include "raster/samples.h"
 
 namespace prast::stepper {
@@ -129,12 +129,15 @@ const char* min_filter_name(MinFilter f) {
     return "LINEAR_MIPMAP_LINEAR";
 }
 
-// "sampler: mag LINEAR, min LINEAR_MIPMAP_LINEAR, wrap repeat/repeat"
+} // namespace
+
 std::string sampler_text(const Texture& tex) {
     const SamplerState& st = tex.sampler();
     return std::string("sampler: mag ") + filter_name(st.mag) + ", min " + min_filter_name(st.min) + ", wrap " +
            wrap_name(st.wrap_s) + "/" + wrap_name(st.wrap_t);
 }
+
+namespace {
 
 // The NEAREST texel of one level: floor(u w), floor(v h), wrapped.
 std::string nearest_footprint(const Texture& tex, glm::vec2 uv, int level) {
@@ -498,46 +501,15 @@ json triangle_json(const FrameSetup& s, const Recording& rec, std::uint32_t tri)
 // ---------------------------------------------------------------- tile
 
 std::string tile_text(const FrameSetup& s, const Recording& rec, int tx, int ty) {
-    std::ostringstream o;
-    const int tile = ty * rec.tiles_x + tx;
-    const TileRecord& t = rec.tiles[std::size_t(tile)];
-    const int x0 = tx * rec.tile_size, y0 = ty * rec.tile_size;
-    o << "tile " << tx << " " << ty << ": pixels x " << x0 << ".." << std::min(x0 + rec.tile_size, rec.width) - 1
-      << " y " << y0 << ".." << std::min(y0 + rec.tile_size, rec.height) - 1 << ", " << t.pieces.size()
-      << " bin entries, " << t.blocks.size() << " blocks, in the order the tile ran them:\n";
-    // Blocks of each piece, in one pass over the tile's blocks.
-    struct Counts { int blocks = 0, covered = 0, passed = 0, written = 0; };
-    std::unordered_map<std::uint32_t, Counts> counts;
-    for (const BlockRecord& b : t.blocks) {
-        Counts& c = counts[b.piece];
-        ++c.blocks;
-        c.covered += __builtin_popcount(b.mask);
-        c.passed += __builtin_popcount(b.pass);
-        c.written += __builtin_popcount(b.live);
-    }
-    for (std::uint32_t pi : t.pieces) {
-        const PieceRecord& p = rec.pieces[pi];
-        const TriangleRecord& tr = rec.triangles[p.triangle];
-        const auto it = counts.find(pi);
-        const Counts c = it == counts.end() ? Counts{} : it->second;
-        const int blocks = c.blocks, covered = c.covered, passed = c.passed, written = c.written;
-        o << "  tri " << p.triangle;
-        if (tr.piece_count > 1) o << " piece " << (pi - tr.first_piece);
-        o << " (" << quoted(mesh_name(s, rec, p.triangle)) << "): " << blocks << " blocks, " << covered
-          << " fragments, " << passed << " passed depth, " << written << " written\n";
-    }
-    return o.str();
+    TileView v;
+    make_tile(s, rec, {std::to_string(tx), std::to_string(ty)}, v);
+    return v.text();
 }
 
 json tile_json(const FrameSetup& s, const Recording& rec, int tx, int ty) {
-    json j;
-    const int tile = ty * rec.tiles_x + tx;
-    j["tile"] = json::array({tx, ty});
-    json tris = json::array();
-    for (std::uint32_t pi : rec.tiles[std::size_t(tile)].pieces) tris.push_back(rec.pieces[pi].triangle);
-    j["triangles"] = tris;
-    j["text"] = tile_text(s, rec, tx, ty);
-    return j;
+    TileView v;
+    make_tile(s, rec, {std::to_string(tx), std::to_string(ty)}, v);
+    return v.json();
 }
 
 // ---------------------------------------------------------------- pixel

@@ -87,6 +87,8 @@ nlohmann::json tile_json(const FrameSetup& s, const Recording& rec, int tx, int 
 nlohmann::json pixel_json(const FrameSetup& s, const Recording& rec, const PixelExplanation& px);
 
 const char* fate_name(TriangleFate f);
+// "sampler: mag LINEAR, min LINEAR_MIPMAP_LINEAR, wrap repeat/repeat"
+std::string sampler_text(const Texture& tex);
 std::string mesh_name(const FrameSetup& s, const Recording& rec, std::uint32_t tri);
 
 // The one name of a triangle both `render --pixel` and `step` print:

@@ -1,16 +1,20 @@
-// The HTTP server (cpp-httplib); see http_server.h.
+// The routes of `step --serve` and the checks every request passes; the
+// connections and their limits are http_connections.h's, the bytes
+// http_wire.h's. See http_server.h.
 #include "stepper/http_server.h"
 
 #include <cctype>
+#include <cstdint>
 #include <cstdio>
-#include <ctime>
 #include <map>
 #include <mutex>
+#include <string>
+#include <vector>
 
-#include <httplib.h>
 #include <nlohmann/json.hpp>
 
 #include "stepper/explain.h"
+#include "stepper/http_connections.h"
 #include "stepper/stages.h"
 #include "stepper/web_assets.h"
 
@@ -20,42 +24,44 @@ namespace {
 
 using nlohmann::json;
 
-// Limits against slow, idle and flooding clients (docs/security.md, "What
-// `step --serve` lets in"): a connection must send something every kReadTimeoutSeconds, an
-// idle keep-alive connection is closed after kKeepAliveSeconds, and one
-// connection serves at most kKeepAliveRequests requests.
-constexpr std::size_t kServerThreads = 16;
-constexpr time_t kReadTimeoutSeconds = 2;
-constexpr time_t kWriteTimeoutSeconds = 5;
-constexpr time_t kKeepAliveSeconds = 2;
-constexpr std::size_t kKeepAliveRequests = 20;
-constexpr std::size_t kMaxBodyBytes = 4096;
-
 // A request error: the status and a one-line message.
 struct BadRequest {
     int status;
     std::string message;
 };
 
-void send_json(httplib::Response& res, const json& j, int status = 200) {
+HttpResponse json_response(const json& j, int status = 200) {
+    HttpResponse res;
     res.status = status;
+    res.content_type = "application/json";
     // Invalid UTF-8 (a mesh name from a file) is replaced, never thrown.
-    res.set_content(j.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
+    res.body = j.dump(-1, ' ', false, json::error_handler_t::replace);
+    return res;
 }
 
-void send_error(httplib::Response& res, int status, const std::string& message) {
-    send_json(res, json{{"error", message}}, status);
+HttpResponse error_response(int status, const std::string& message) {
+    return json_response(json{{"error", message}}, status);
 }
 
-// An integer query parameter in [lo, hi].
-long int_param(const httplib::Request& req, const char* name, long lo, long hi) {
-    if (!req.has_param(name)) throw BadRequest{400, std::string("missing parameter '") + name + "'"};
-    if (req.get_param_value_count(name) > 1) throw BadRequest{400, std::string("parameter '") + name + "' given twice"};
-    const std::string v = req.get_param_value(name);
+// A refusal before any route: the connection is closed after it (a body
+// it announced is never read).
+HttpResponse refusal(int status, const std::string& message) {
+    HttpResponse res = error_response(status, message);
+    res.close = true;
+    return res;
+}
+
+// An integer query parameter in [lo, hi]; `what` names it in the message
+// ("triangle number 'n' must be in 0..98431 (the frame has 98432
+// triangles)"), which holds the frame's numbers, never the request's.
+long int_param(const HttpRequest& req, const char* name, long lo, long hi, const std::string& what,
+               const std::string& why) {
+    if (!req.param_count(name)) throw BadRequest{400, std::string("missing parameter '") + name + "'"};
+    if (req.param_count(name) > 1) throw BadRequest{400, std::string("parameter '") + name + "' given twice"};
     long out = 0;
-    if (!parse_int(v, lo, hi, out))
-        throw BadRequest{400, std::string("parameter '") + name + "': expected an integer in " + std::to_string(lo) +
-                                  ".." + std::to_string(hi)};
+    if (!parse_int(req.param(name), lo, hi, out))
+        throw BadRequest{400, what + " '" + name + "' must be in " + std::to_string(lo) + ".." + std::to_string(hi) +
+                                  " (" + why + ")"};
     return out;
 }
 
@@ -84,150 +90,177 @@ bool host_allowed(const std::string& host, int port) {
 // the page's origin in Origin and say in Sec-Fetch-Site whether it is ours.
 // Requests from our page or typed in the address bar pass; so do clients
 // that send neither (curl, scripts).
-bool cross_origin(const httplib::Request& req, int port) {
-    if (req.has_header("Origin")) {
-        const std::string origin = req.get_header_value("Origin"), p = ":" + std::to_string(port);
-        if (origin != "http://127.0.0.1" + p && origin != "http://localhost" + p) return true;
-    }
-    if (req.has_header("Sec-Fetch-Site")) {
-        const std::string site = req.get_header_value("Sec-Fetch-Site");
-        if (site != "same-origin" && site != "none") return true;
+bool cross_origin(const HttpRequest& req, int port) {
+    const std::string p = ":" + std::to_string(port);
+    for (const auto& [name, value] : req.headers) {
+        if (name == "origin" && value != "http://127.0.0.1" + p && value != "http://localhost" + p) return true;
+        if (name == "sec-fetch-site" && value != "same-origin" && value != "none") return true;
     }
     return false;
+}
+
+bool is_other_method(const std::string& m) {
+    for (const char* known : {"POST", "PUT", "DELETE", "PATCH", "OPTIONS", "TRACE", "CONNECT"})
+        if (m == known) return true;
+    return false;
+}
+
+HttpResponse asset_response(const WebAsset& a) {
+    HttpResponse res;
+    res.content_type = a.mime;
+    res.body.assign(reinterpret_cast<const char*>(a.data), a.size);
+    return res;
+}
+
+// The tab's icon, drawn here: a 16x16 ICO (one 32-bit BMP image) holding an
+// orange triangle, so a browser's request for /favicon.ico is answered.
+std::string make_favicon() {
+    constexpr int kSide = 16;
+    std::string ico;
+    auto u16 = [&](unsigned v) { ico += char(v & 0xff); ico += char(v >> 8); };
+    auto u32 = [&](std::uint32_t v) { u16(v & 0xffff); u16(v >> 16); };
+    const std::uint32_t image_bytes = 40 + kSide * kSide * 4 + kSide * 4;  // header, BGRA, AND mask
+    u16(0); u16(1); u16(1);                                    // ICONDIR: an icon, one image
+    ico += char(kSide); ico += char(kSide); ico += '\0'; ico += '\0';
+    u16(1); u16(32); u32(image_bytes); u32(22);                // ICONDIRENTRY
+    u32(40); u32(kSide); u32(2 * kSide); u16(1); u16(32);      // BITMAPINFOHEADER (height: image and mask)
+    for (int i = 0; i < 6; ++i) u32(0);
+    // Pixel centres inside the triangle (1,14) (15,14) (8,1), rows bottom-up.
+    auto edge = [](double ax, double ay, double bx, double by, double px, double py) {
+        return (bx - ax) * (py - ay) - (by - ay) * (px - ax);
+    };
+    for (int row = kSide - 1; row >= 0; --row)
+        for (int col = 0; col < kSide; ++col) {
+            const double px = col + 0.5, py = row + 0.5;
+            const bool inside = edge(1, 14, 15, 14, px, py) <= 0 && edge(15, 14, 8, 1, px, py) <= 0 &&
+                                edge(8, 1, 1, 14, px, py) <= 0;
+            const char bgra[4] = {char(0x20), char(0x78), char(0xe8), char(inside ? 0xff : 0)};
+            ico.append(bgra, 4);
+        }
+    ico.append(kSide * 4, '\0');  // the AND mask: unused with alpha
+    return ico;
 }
 
 } // namespace
 
 int serve(Session& session, int port) {
-    httplib::Server server;
     std::mutex mutex;  // the session and the recording are used by one request at a time
     std::map<std::string, std::string> png_cache;
     const Recording& rec = session.recording();
     FrameSetup& s = session.scene();
 
-    // Runs a handler under the lock, turning bad requests into 4xx JSON.
-    auto guarded = [&](auto handler) {
-        return [&, handler](const httplib::Request& req, httplib::Response& res) {
-            std::lock_guard<std::mutex> lock(mutex);
-            try {
-                handler(req, res);
-            } catch (const BadRequest& e) {
-                send_error(res, e.status, e.message);
-            }
-        };
-    };
-    auto send_png = [&](httplib::Response& res, const std::string& key, auto make) {
+    std::string error;
+    int bound = 0;
+    const int listen_fd = listen_loopback(port, bound, error);
+    if (listen_fd < 0) {
+        std::fprintf(stderr, "step: %s\n", error.c_str());
+        return 1;
+    }
+
+    const std::string triangles = std::to_string(rec.triangle_count());
+    const std::string frame_has = "the frame has " + triangles + " triangles";
+    const std::string image_is = "the image is " + std::to_string(rec.width) + "x" + std::to_string(rec.height);
+    const std::string tiles_are =
+        "the frame has " + std::to_string(rec.tiles_x) + "x" + std::to_string(rec.tiles_y) + " tiles";
+    auto png_response = [&](const std::string& key, auto make) {
         auto it = png_cache.find(key);
         if (it == png_cache.end()) {
             if (png_cache.size() > 64) png_cache.clear();  // bound the memory of many slider positions
             const std::vector<std::uint8_t> png = make();
             it = png_cache.emplace(key, std::string(png.begin(), png.end())).first;
         }
-        res.set_content(it->second, "image/png");
+        HttpResponse res;
+        res.content_type = "image/png";
+        res.body = it->second;
+        return res;
     };
-
-    server.Get("/", [](const httplib::Request&, httplib::Response& res) {
-        const WebAsset* a = find_web_asset("/index.html");
-        res.set_content(reinterpret_cast<const char*>(a->data), a->size, a->mime);
-    });
-    server.Get(R"(/(index\.html|step\.js|step\.css))", [](const httplib::Request& req, httplib::Response& res) {
-        const WebAsset* a = find_web_asset(req.path);
-        if (!a) return send_error(res, 404, "not found");
-        res.set_content(reinterpret_cast<const char*>(a->data), a->size, a->mime);
-    });
-    server.Get("/api/frame", guarded([&](const httplib::Request&, httplib::Response& res) {
-        send_json(res, frame_json(s, rec));
-    }));
-    server.Get("/api/stages", guarded([&](const httplib::Request&, httplib::Response& res) {
-        json list = json::array();
-        for (const StageInfo& st : stage_list()) list.push_back({{"name", st.name}, {"title", st.title}, {"about", st.about}});
-        send_json(res, list);
-    }));
-    server.Get("/api/stage", guarded([&](const httplib::Request& req, httplib::Response& res) {
-        const std::string name = req.get_param_value("name");
-        if (!find_stage(name)) throw BadRequest{404, "unknown stage (see /api/stages)"};
-        send_png(res, "stage " + name, [&] { return session.stage_png(name); });
-    }));
-    server.Get("/api/upto", guarded([&](const httplib::Request& req, httplib::Response& res) {
-        const long n = int_param(req, "n", 0, long(rec.triangle_count()));
-        send_png(res, "upto " + std::to_string(n), [&] { return session.upto_png(std::uint64_t(n)); });
-    }));
-    server.Get("/api/pixel", guarded([&](const httplib::Request& req, httplib::Response& res) {
-        const long x = int_param(req, "x", 0, rec.width - 1), y = int_param(req, "y", 0, rec.height - 1);
-        send_json(res, pixel_json(s, rec, explain_pixel(s, rec, int(x), int(y))));
-    }));
-    server.Get("/api/tri", guarded([&](const httplib::Request& req, httplib::Response& res) {
-        const long n = int_param(req, "n", 0, long(rec.triangle_count()) - 1);
-        send_json(res, triangle_json(s, rec, std::uint32_t(n)));
-    }));
-    server.Get("/api/tile", guarded([&](const httplib::Request& req, httplib::Response& res) {
-        const long x = int_param(req, "x", 0, rec.tiles_x - 1), y = int_param(req, "y", 0, rec.tiles_y - 1);
-        send_json(res, tile_json(s, rec, int(x), int(y)));
-    }));
-    // Anything else: a JSON 404 (or the status httplib chose, e.g. 414 for a huge URI).
-    server.set_error_handler([](const httplib::Request&, httplib::Response& res) {
-        if (res.body.empty()) send_error(res, res.status == 200 ? 404 : res.status,
-                                         res.status == 404 ? "not found" : "bad request");
-    });
-    server.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
-        std::string what = "internal error";
-        try {
-            if (ep) std::rethrow_exception(ep);
-        } catch (const std::exception& e) {
-            what = e.what();
-        } catch (...) {
+    // The API: one request at a time, on the session.
+    auto api = [&](const HttpRequest& req) -> HttpResponse {
+        const std::string& path = req.path;
+        if (path == "/api/frame") return json_response(frame_json(s, rec));
+        if (path == "/api/stages") return json_response(stage_list_json(s, rec));
+        if (path == "/api/stage") {
+            const std::string name = req.param("name");
+            if (!find_stage(name)) throw BadRequest{404, "unknown stage (see /api/stages)"};
+            return png_response("stage " + name, [&] { return session.stage_png(name); });
         }
-        send_error(res, 500, what);
-    });
-    server.set_payload_max_length(kMaxBodyBytes);
-    // Idle and slow connections (a browser's keep-alive, a stalled client)
-    // hold a worker only briefly; more workers than cores, because requests
-    // wait for the session's lock anyway and a stalled socket costs no CPU.
-    server.set_read_timeout(kReadTimeoutSeconds, 0);
-    server.set_write_timeout(kWriteTimeoutSeconds, 0);
-    server.set_keep_alive_timeout(kKeepAliveSeconds);
-    server.set_keep_alive_max_count(kKeepAliveRequests);
-    server.new_task_queue = [] { return new httplib::ThreadPool(kServerThreads); };
+        if (path == "/api/upto") {
+            const long n = int_param(req, "n", 0, long(rec.triangle_count()), "triangle count", frame_has);
+            return png_response("upto " + std::to_string(n), [&] { return session.upto_png(std::uint64_t(n)); });
+        }
+        if (path == "/api/pixel") {
+            const long x = int_param(req, "x", 0, rec.width - 1, "pixel column", image_is);
+            const long y = int_param(req, "y", 0, rec.height - 1, "pixel row", image_is);
+            return json_response(pixel_json(s, rec, explain_pixel(s, rec, int(x), int(y))));
+        }
+        if (path == "/api/tri") {
+            const long n = int_param(req, "n", 0, long(rec.triangle_count()) - 1, "triangle number", frame_has);
+            return json_response(triangle_json(s, rec, std::uint32_t(n)));
+        }
+        if (path == "/api/tile") {
+            const long x = int_param(req, "x", 0, rec.tiles_x - 1, "tile column", tiles_are);
+            const long y = int_param(req, "y", 0, rec.tiles_y - 1, "tile row", tiles_are);
+            return json_response(tile_json(s, rec, int(x), int(y)));
+        }
+        return error_response(404, "not found");
+    };
+    const std::string favicon = make_favicon();
+
+    HttpApp app;
+    app.handle = [&](const HttpRequest& req) -> HttpResponse {
+        // Before any route: our Host names only, read-only methods, no
+        // body, no ranges (a Range header asking for the same bytes
+        // thousands of times would multiply the answer).
+        if (req.header_count("host") != 1 || !host_allowed(req.header("host"), bound))
+            return refusal(403, "the Host header must be 127.0.0.1 or localhost (with this server's port)");
+        if (cross_origin(req, bound)) return refusal(403, "a request from another site's page");
+        if (req.method != "GET" && req.method != "HEAD") {
+            if (!is_other_method(req.method)) return refusal(400, "unknown method");
+            HttpResponse res = refusal(405, "read-only: only GET and HEAD");
+            res.headers.emplace_back("Allow", "GET, HEAD");
+            return res;
+        }
+        if (req.header_count("transfer-encoding") ||
+            (req.header_count("content-length") && (req.header_count("content-length") > 1 ||
+                                                    req.header("content-length") != "0")))
+            return refusal(400, "a GET request has no body");
+        if (req.header_count("range")) return refusal(416, "range requests are not served");
+
+        // The page's files, built in, by exact name.
+        if (req.path == "/") return asset_response(*find_web_asset("/index.html"));
+        if (req.path == "/index.html" || req.path == "/step.js" || req.path == "/step.css") {
+            const WebAsset* a = find_web_asset(req.path);
+            return a ? asset_response(*a) : error_response(404, "not found");
+        }
+        if (req.path == "/favicon.ico") {
+            HttpResponse res;
+            res.content_type = "image/x-icon";
+            res.body = favicon;
+            return res;
+        }
+        if (req.path.compare(0, 5, "/api/") != 0) return error_response(404, "not found");
+        std::lock_guard<std::mutex> lock(mutex);
+        try {
+            return api(req);
+        } catch (const BadRequest& e) {
+            return error_response(e.status, e.message);
+        } catch (const std::exception& e) {
+            return error_response(500, e.what());
+        }
+    };
+    app.refuse = [](int status, const char* message) { return refusal(status, message); };
     // Responses are never sniffed as another type, never framed, never
     // cached; the page loads only its own files (no inline script, no CDN).
-    server.set_default_headers({
-        {"X-Content-Type-Options", "nosniff"},
-        {"Cache-Control", "no-store"},
-        {"Referrer-Policy", "no-referrer"},
-        {"Content-Security-Policy", "default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'; "
-                                    "connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'none'"},
-    });
+    app.common_headers =
+        "X-Content-Type-Options: nosniff\r\n"
+        "Cache-Control: no-store\r\n"
+        "Referrer-Policy: no-referrer\r\n"
+        "Content-Security-Policy: default-src 'self'; img-src 'self'; style-src 'self'; script-src 'self'; "
+        "connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'none'\r\n";
 
-    int bound = port;
-    if (port == 0) bound = server.bind_to_any_port("127.0.0.1");
-    else if (!server.bind_to_port("127.0.0.1", port)) bound = -1;
-    if (bound <= 0) {
-        std::fprintf(stderr, "step: cannot listen on 127.0.0.1:%d (in use? try --port 0)\n", port);
-        return 1;
-    }
-    // Before any route: our Host names only, read-only methods, no body
-    // (httplib does not read a GET's body, so it would be parsed as the
-    // next request on the connection).
-    server.set_pre_routing_handler([bound](const httplib::Request& req, httplib::Response& res) {
-        if (req.get_header_value_count("Host") != 1 || !host_allowed(req.get_header_value("Host"), bound)) {
-            send_error(res, 403, "the Host header must be 127.0.0.1 or localhost (with this server's port)");
-        } else if (cross_origin(req, bound)) {
-            send_error(res, 403, "a request from another site's page");
-        } else if (req.method != "GET" && req.method != "HEAD") {
-            res.set_header("Allow", "GET, HEAD");
-            send_error(res, 405, "read-only: only GET and HEAD");
-        } else if (req.has_header("Transfer-Encoding") ||
-                   (req.has_header("Content-Length") && req.get_header_value("Content-Length") != "0")) {
-            send_error(res, 400, "a GET request has no body");
-        } else {
-            return httplib::Server::HandlerResponse::Unhandled;
-        }
-        return httplib::Server::HandlerResponse::Handled;
-    });
     std::printf("step: serving http://127.0.0.1:%d/ (Ctrl-C to stop)\n", bound);
     std::fflush(stdout);
-    server.listen_after_bind();
-    return 0;
+    return serve_connections(listen_fd, app);
 }
 
 } // namespace prast::stepper

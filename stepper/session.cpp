@@ -3,11 +3,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <sstream>
+#include <stdexcept>
 
 #include "scene/write_image.h"
 #include "shading/tonemap.h"
@@ -15,6 +17,7 @@
 #include "stepper/format.h"
 #include "stepper/replay.h"
 #include "stepper/stages.h"
+#include "stepper/views.h"
 
 namespace prast::stepper {
 
@@ -49,6 +52,20 @@ bool parse_int(const std::string& word, long lo, long hi, long& out) {
 }
 
 namespace {
+
+// Writes bytes next to `path` under a temporary name, then renames it over
+// `path`: no truncated file is ever left behind.
+void write_bytes_atomic(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    const std::string tmp = path + ".tmp";
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw std::runtime_error(path + ": cannot write (" + std::strerror(errno) + ")");
+    const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+        const std::string why = std::strerror(errno);
+        std::remove(tmp.c_str());
+        throw std::runtime_error(path + ": cannot write (" + why + ")");
+    }
+}
 
 Reply error(const std::string& message) { return Reply{false, false, "error: " + message + "\n"}; }
 
@@ -200,8 +217,16 @@ Reply Session::help() const {
         "  frame                the frame's counters, camera, lights and the recording's size\n"
         "  tri N                triangle N: clip coordinates, clipping, fixed-point setup, edges, bins, tile walk\n"
         "  tri draw D triangle P  the same for triangle P of draw D (the name pixel and render --pixel print)\n"
-        "  tile X Y             the triangles binned to tile X Y (tile columns and rows), in order\n"
+        "  tile X Y [FILTER]    tile X Y (column, row): a summary, then its bins in order; FILTER: tri N,\n"
+        "                       pixel X Y (the bins that cover that pixel) or --summary\n"
         "  pixel X Y            the history of pixel X Y and the shading breakdown of the winning fragment\n"
+        "  draws                one line a draw: mesh, material, primitives, visible or culled, alpha, program\n"
+        "  draw N               draw N's state: material factors, maps and samplers, cull/depth/blend, lights\n"
+        "  textures             every texture ID (material maps, shadowL maps, env) with size, format, levels\n"
+        "  texture ID [LEVEL [FILE]]  a texture's format and levels; writes the level (default 0) as a PNG\n"
+        "                       (default texture-ID-level-L.png)\n"
+        "  json VIEW ...        the JSON of draws, draw, textures, texture, vertices or tile, on one line\n"
+        "  vertices N [FIRST [COUNT]]  draw N's vertices in and out of the vertex stage (16 from 0; at most 1000)\n"
         "  upto N [FILE]        write the image after the first N triangles (default upto-N.png)\n"
         "  stage NAME [FILE]    write one stage image (default stage-NAME.png); NAME is one of:\n"
         "                      ";
@@ -250,13 +275,87 @@ Reply Session::run(const std::string& line) {
             return error("tri '" + w[1] + "': not a triangle number (" + count_range(rec_.triangle_count()) + ")");
         return Reply{true, false, triangle_text(s_, rec_, std::uint32_t(a))};
     }
-    if (cmd == "tile") {
-        if (!args(2, 2)) return error("usage: tile X Y (tile column and row)");
-        if (!parse_int(w[1], 0, rec_.tiles_x - 1, a) || !parse_int(w[2], 0, rec_.tiles_y - 1, b))
-            return error("tile '" + w[1] + " " + w[2] + "': outside the " + std::to_string(rec_.tiles_x) + "x" +
-                         std::to_string(rec_.tiles_y) + " tiles");
-        return Reply{true, false, tile_text(s_, rec_, int(a), int(b))};
+    if (cmd == "json") {
+        // The JSON the page's API serves for a view: one line.
+        static const char* kViews[] = {"draws", "draw", "textures", "texture", "vertices", "tile"};
+        if (w.size() < 2 || std::find(std::begin(kViews), std::end(kViews), w[1]) == std::end(kViews))
+            return error("usage: json draws | draw N | textures | texture ID [LEVEL] | vertices N [FIRST [COUNT]] | "
+                         "tile X Y [FILTER]");
+        if (w[1] == "texture" && w.size() > 4) return error("usage: json texture ID [LEVEL]");
+        std::string rest;
+        for (std::size_t i = 1; i < w.size(); ++i) rest += (i > 1 ? " " : "") + w[i];
+        return run_view(rest, true);
     }
+    if (cmd == "tile" || cmd == "draws" || cmd == "draw" || cmd == "textures" || cmd == "texture" ||
+        cmd == "vertices")
+        return run_view(line, false);
+    return run_rest(w);
+}
+
+Reply Session::run_view(const std::string& line, bool as_json) {
+    const std::vector<std::string> w = split_words(line);
+    const std::string& cmd = w[0];
+    auto args = [&](std::size_t lo, std::size_t hi) { return w.size() - 1 >= lo && w.size() - 1 <= hi; };
+    auto reply = [&](const auto& v) { return Reply{true, false, as_json ? v.json().dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+                                                  : v.text()}; };
+    if (cmd == "tile") {
+        TileView v;
+        const std::string e = make_tile(s_, rec_, std::vector<std::string>(w.begin() + 1, w.end()), v);
+        return e.empty() ? reply(v) : error(e);
+    }
+    if (cmd == "draws") {
+        if (!args(0, 0)) return error("draws takes no arguments");
+        DrawsView v;
+        make_draws(s_, rec_, v);
+        return reply(v);
+    }
+    if (cmd == "draw") {
+        if (!args(1, 1)) return error("usage: draw N (draws lists them)");
+        DrawView v;
+        const std::string e = make_draw(s_, rec_, w[1], v);
+        return e.empty() ? reply(v) : error(e);
+    }
+    if (cmd == "textures") {
+        if (!args(0, 0)) return error("textures takes no arguments");
+        TexturesView v;
+        make_textures(s_, rec_, v);
+        return reply(v);
+    }
+    if (cmd == "texture") {
+        if (!args(1, 3)) return error("usage: texture ID [LEVEL [FILE]] (textures lists the IDs)");
+        const std::string level = w.size() > 2 ? w[2] : "";
+        TextureView v;
+        std::string e = make_texture(s_, rec_, w[1], level, v);
+        if (!e.empty()) return error(e);
+        if (as_json) return reply(v);
+        const std::string file =
+            w.size() > 3 ? w[3] : "texture-" + w[1] + "-level-" + std::to_string(v.level) + ".png";
+        std::vector<std::uint8_t> png;
+        e = texture_png(s_, rec_, w[1], level, png);
+        if (!e.empty()) return error(e);
+        try {
+            write_bytes_atomic(file, png);
+        } catch (const std::exception& ex) {
+            return error(ex.what());
+        }
+        return Reply{true, false,
+                     v.text() + "texture " + w[1] + " " + std::to_string(v.level) + " -> wrote " + file + "\n"};
+    }
+    if (cmd == "vertices") {
+        if (!args(1, 3)) return error("usage: vertices N [FIRST [COUNT]] (draw N; FIRST 0 and COUNT " +
+                                      std::to_string(kDefaultVertexRows) + " by default)");
+        VerticesView v;
+        const std::string e =
+            make_vertices(s_, rec_, w[1], w.size() > 2 ? w[2] : "", w.size() > 3 ? w[3] : "", v);
+        return e.empty() ? reply(v) : error(e);
+    }
+    return error("unknown command '" + cmd + "'");
+}
+
+Reply Session::run_rest(const std::vector<std::string>& w) {
+    const std::string& cmd = w[0];
+    auto args = [&](std::size_t lo, std::size_t hi) { return w.size() - 1 >= lo && w.size() - 1 <= hi; };
+    long a = 0, b = 0;
     if (cmd == "pixel") {
         if (!args(2, 2)) return error("usage: pixel X Y");
         if (!parse_int(w[1], 0, rec_.width - 1, a) || !parse_int(w[2], 0, rec_.height - 1, b))

@@ -34,6 +34,11 @@ public:
 
 private:
     Reply help() const;
+    // The views of views.h (draws, draw, textures, texture, vertices, tile):
+    // their text, or with as_json their JSON on one line.
+    Reply run_view(const std::string& line, bool as_json);
+    // The commands after the views.
+    Reply run_rest(const std::vector<std::string>& words);
     Reply cost();
     Reply verify();
 

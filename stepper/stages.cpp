@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "shading/color.h"
@@ -93,6 +94,26 @@ void put(Image& img, const Recording& rec, int x, int y, glm::vec3 c) {
     for (int k = 0; k < 3; ++k) p[k] = std::uint8_t(std::lround(glm::clamp(c[k], 0.0f, 1.0f) * 255.0f));
 }
 
+// Vertices per pixel: brighter with more, white from 4.
+glm::vec3 vertex_grey(int count) { return glm::vec3(std::min(1.0f, 0.45f + 0.15f * float(count))); }
+
+// The wireframe's colours, by what became of the triangle.
+const glm::vec3 kSetUp(1.0f), kClipped(1.0f, 0.55f, 0.1f), kBack(0.15f, 0.2f, 0.6f), kDegenerate(1.0f, 0.0f, 1.0f);
+
+// Bins: h = log2(1 + entries) / log2(1 + the fullest tile's), blue to red.
+glm::vec3 bins_colour(float h) { return glm::mix(glm::vec3(0.1f, 0.2f, 1.0f), glm::vec3(1.0f, 0.15f, 0.05f), h); }
+const glm::vec3 kTileBorder(0.5f);
+
+// Depth: t = 0 at the near plane (white) to 1 at the far plane (black).
+glm::vec3 depth_grey(float t) { return glm::vec3(1.0f - t); }
+
+// MSAA: fragments per pixel, with or without background samples.
+const glm::vec3 kOneFragment(0.3f), kTwo(1.0f, 0.6f, 0.1f), kThree(1.0f, 0.1f, 0.1f),
+    kBackgroundAndOne(0.1f, 0.4f, 1.0f), kBackgroundAndTwo(0.2f, 1.0f, 1.0f);
+
+// NaN stage.
+const glm::vec3 kNan(1, 0, 0), kInf(1, 0, 1), kNegative(0, 0, 1), kClean(0.25f);
+
 glm::vec3 heat(int n) {
     static const glm::vec3 kRamp[] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0},
                                       {1, 0, 1}, {1, 0.5f, 1}, {1, 0.8f, 1}, {1, 1, 1}};
@@ -151,13 +172,12 @@ void draw_vertices(const Recording& rec, Image& img) {
     for (int y = 0; y < rec.height; ++y)
         for (int x = 0; x < rec.width; ++x) {
             const int c = count[std::size_t(y) * rec.width + x];
-            if (c) put(img, rec, x, y, glm::vec3(std::min(1.0f, 0.45f + 0.15f * float(c))));
+            if (c) put(img, rec, x, y, vertex_grey(c));
         }
 }
 
 void draw_wireframe(const FrameSetup& s, const Recording& rec, Image& img) {
     fill(img, rec, 0);
-    const glm::vec3 kSetUp(1.0f), kClipped(1.0f, 0.55f, 0.1f), kBack(0.15f, 0.2f, 0.6f), kDegenerate(1.0f, 0.0f, 1.0f);
     auto triangle = [&](const float* a, const float* b, const float* c, glm::vec3 col) {
         double x[3], y[3];
         if (!project(a, rec, x[0], y[0]) || !project(b, rec, x[1], y[1]) || !project(c, rec, x[2], y[2])) return;
@@ -198,9 +218,9 @@ void draw_bins(const Recording& rec, Image& img) {
             glm::vec3 c(0.0f);
             if (n) {
                 const float h = float(std::log2(1.0 + double(n)) / std::log2(1.0 + double(most)));
-                c = glm::mix(glm::vec3(0.1f, 0.2f, 1.0f), glm::vec3(1.0f, 0.15f, 0.05f), h);
+                c = bins_colour(h);
             }
-            if (x % rec.tile_size == 0 || y % rec.tile_size == 0) c = glm::vec3(0.5f);
+            if (x % rec.tile_size == 0 || y % rec.tile_size == 0) c = kTileBorder;
             put(img, rec, x, y, c);
         }
 }
@@ -214,7 +234,7 @@ void draw_depth(const FrameSetup& s, const Recording& rec, Image& img) {
             if (!(z < 1.0f)) continue;
             const float z_ndc = z * 2.0f - 1.0f;
             const float d = 2.0f * n * f / (f + n - z_ndc * (f - n));
-            put(img, rec, x, y, glm::vec3(1.0f - glm::clamp((d - n) / (f - n), 0.0f, 1.0f)));
+            put(img, rec, x, y, depth_grey(glm::clamp((d - n) / (f - n), 0.0f, 1.0f)));
         }
 }
 
@@ -335,9 +355,9 @@ void draw_msaa(const Recording& rec, Image& img) {
                 for (int s = 0; s < o.samples; ++s) background |= o.at(x, y, s) < 0;
                 const int n = o.distinct(x, y);
                 glm::vec3 c(0.0f);
-                if (n == 1 && !background) c = glm::vec3(0.3f);
-                else if (n == 2) c = background ? glm::vec3(0.1f, 0.4f, 1.0f) : glm::vec3(1.0f, 0.6f, 0.1f);
-                else if (n >= 3) c = background ? glm::vec3(0.2f, 1.0f, 1.0f) : glm::vec3(1.0f, 0.1f, 0.1f);
+                if (n == 1 && !background) c = kOneFragment;
+                else if (n == 2) c = background ? kBackgroundAndOne : kTwo;
+                else if (n >= 3) c = background ? kBackgroundAndTwo : kThree;
                 put(img, rec, x, y, c);
             }
     }
@@ -368,8 +388,7 @@ void draw_nan(const Recording& rec, Image& img) {
                 inf |= std::isinf(c[k]);
                 neg |= c[k] < 0.0f;
             }
-            put(img, rec, x, y, nan ? glm::vec3(1, 0, 0) : inf ? glm::vec3(1, 0, 1) : neg ? glm::vec3(0, 0, 1)
-                                                                                      : glm::vec3(0.25f));
+            put(img, rec, x, y, nan ? kNan : inf ? kInf : neg ? kNegative : kClean);
         }
 }
 
@@ -493,6 +512,182 @@ void draw_stage(FrameSetup& s, const Recording& rec, const std::string& name, st
     std::vector<Image> images;
     draw_stages(s, rec, {name}, images);
     rgba8 = std::move(images[0]);
+}
+
+namespace {
+
+std::uint8_t to_byte(float v) { return std::uint8_t(std::lround(glm::clamp(v, 0.0f, 1.0f) * 255.0f)); }
+
+// The bytes put() writes for colour c.
+LegendColour legend(glm::vec3 c, std::string label = "") {
+    return LegendColour{{to_byte(c.r), to_byte(c.g), to_byte(c.b)}, std::move(label)};
+}
+
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return buf;
+}
+
+StageScale ramp(std::string quantity, std::string units, std::string map, double lo, double hi) {
+    StageScale sc;
+    sc.kind = "ramp";
+    sc.quantity = std::move(quantity);
+    sc.units = std::move(units);
+    sc.map = std::move(map);
+    sc.min = lo;
+    sc.max = hi;
+    return sc;
+}
+
+StageScale classes(std::string quantity, std::vector<LegendColour> list) {
+    StageScale sc;
+    sc.kind = "classes";
+    sc.quantity = std::move(quantity);
+    sc.classes = std::move(list);
+    return sc;
+}
+
+StageScale channels(std::string quantity, std::vector<std::string> names, double lo, double hi, bool srgb_encoded) {
+    StageScale sc;
+    sc.kind = "channels";
+    sc.quantity = std::move(quantity);
+    sc.channels = std::move(names);
+    sc.min = lo;
+    sc.max = hi;
+    sc.srgb = srgb_encoded;
+    return sc;
+}
+
+// A grey ramp from 0 (black) to 1 (white), ticks every quarter.
+StageScale grey_ramp(std::string quantity) {
+    StageScale sc = ramp(std::move(quantity), "", "linear", 0.0, 1.0);
+    sc.stops = {{0.0, legend(glm::vec3(0.0f))}, {1.0, legend(glm::vec3(1.0f))}};
+    for (int i = 0; i <= 4; ++i) sc.ticks.push_back({i / 4.0, number(i / 4.0)});
+    return sc;
+}
+
+const char* kNoFragment = "no fragment (the background)";
+
+std::vector<LegendColour> heat_classes() {
+    std::vector<LegendColour> out;
+    for (int n = 0; n <= 8; ++n) out.push_back(legend(heat(n), n == 8 ? "8 or more" : std::to_string(n)));
+    return out;
+}
+
+} // namespace
+
+StageScale stage_scale(const FrameSetup& s, const Recording& rec, const std::string& name) {
+    const glm::vec3 black(0.0f);
+    if (name == "vertices") {
+        std::vector<LegendColour> list = {legend(black, "no vertex")};
+        for (int c = 1; c <= 4; ++c) list.push_back(legend(vertex_grey(c), c == 4 ? "4 or more" : std::to_string(c)));
+        return classes("vertices projected to the pixel", list);
+    }
+    if (name == "wireframe")
+        return classes("what became of the triangle",
+                       {legend(kSetUp, "set up"), legend(kClipped, "a piece of a clipped triangle"),
+                        legend(kBack, "back face, culled"), legend(kDegenerate, "degenerate"),
+                        legend(black, "no edge")});
+    if (name == "bins") {
+        std::size_t most = 1;
+        for (const TileRecord& t : rec.tiles) most = std::max(most, t.pieces.size());
+        StageScale sc = ramp("bin entries of the pixel's tile", "triangles", "log1p", 0.0, double(most));
+        sc.stops = {{0.0, legend(bins_colour(0.0f))}, {1.0, legend(bins_colour(1.0f))}};
+        const double top = std::log2(1.0 + double(most));
+        auto at = [&](double n) { return std::log2(1.0 + n) / top; };
+        sc.ticks.push_back({at(1.0), "1"});
+        for (double n = 10.0; n < double(most) * 0.7; n *= 10.0) sc.ticks.push_back({at(n), number(n)});
+        if (most > 1) sc.ticks.push_back({1.0, number(double(most))});
+        sc.classes = {legend(black, "an empty tile (0)"), legend(kTileBorder, "tile borders")};
+        return sc;
+    }
+    if (name == "depth") {
+        const double n = s.settings.camera.near_plane, f = s.settings.camera.far_plane;
+        StageScale sc = ramp("distance from the eye along the view axis (linearised depth)", "scene units", "linear",
+                             n, f);
+        sc.stops = {{0.0, legend(depth_grey(0.0f))}, {1.0, legend(depth_grey(1.0f))}};
+        for (int i = 0; i <= 4; ++i) sc.ticks.push_back({i / 4.0, number(n + (f - n) * i / 4.0)});
+        sc.ticks.front().second += " (near)";
+        sc.ticks.back().second += " (far)";
+        sc.classes = {legend(black, "far, or no fragment (depth 1)")};
+        return sc;
+    }
+    if (name == "overdraw") return classes("fragments covered per pixel, before the depth test", heat_classes());
+    if (name == "shaded") return classes("fragment-program runs per pixel", heat_classes());
+    if (name == "quad_overdraw") return classes("shader lanes per pixel, helper lanes included", heat_classes());
+    if (name == "msaa")
+        return classes("fragments the resolve averages",
+                       {legend(black, "background only"), legend(kOneFragment, "1 fragment"),
+                        legend(kTwo, "2 fragments"), legend(kThree, "3 or more fragments"),
+                        legend(kBackgroundAndOne, "background and 1 fragment"),
+                        legend(kBackgroundAndTwo, "background and 2 or more")});
+    if (name == "triangle_size") {
+        StageScale sc = ramp("area of the triangle that won the pixel", "px", "log", 1.0, 4096.0);
+        for (int i = 0; i <= 4; ++i) {
+            sc.stops.push_back({i / 4.0, legend(rainbow(float(i) / 4.0f))});
+            sc.ticks.push_back({i / 4.0, std::to_string(1 << (3 * i))});
+        }
+        sc.ticks.front().second = "1 or less";
+        sc.ticks.back().second = "4096 or more";
+        sc.classes = {legend(black, kNoFragment)};
+        return sc;
+    }
+    if (name == "nan")
+        return classes("the pixel's linear colour",
+                       {legend(kNan, "a NaN"), legend(kInf, "an infinity"), legend(kNegative, "a negative value"),
+                        legend(kClean, "finite and not negative")});
+    StageScale sc;
+    if (name == "albedo") sc = channels("base colour", {"red", "green", "blue"}, 0.0, 1.0, true);
+    else if (name == "normal") sc = channels("world-space shading normal", {"x", "y", "z"}, -1.0, 1.0, false);
+    else if (name == "roughness") sc = grey_ramp("perceptual roughness");
+    else if (name == "metallic") sc = grey_ramp("metalness");
+    else if (name == "occlusion") sc = grey_ramp("ambient occlusion");
+    else if (name == "G") sc = grey_ramp("G, Smith shadowing-masking (first light)");
+    else if (name == "F") sc = channels("F, Schlick Fresnel (first light)", {"red", "green", "blue"}, 0.0, 1.0, false);
+    else if (name == "diffuse" || name == "specular")
+        sc = channels(name + " radiance times exposure", {"red", "green", "blue"}, 0.0, 1.0, true);
+    else if (name == "mip") {
+        sc = ramp("level of detail lambda of the base colour map", "mip levels", "linear", 0.0, 5.0);
+        for (int l = 0; l <= 5; ++l) {
+            sc.stops.push_back({l / 5.0, legend(mip_colour(float(l)))});
+            sc.ticks.push_back({l / 5.0, l == 0 ? "0 or less" : l == 5 ? "5 or more" : std::to_string(l)});
+        }
+        sc.classes = {legend(black, "no texture map, or no fragment")};
+        return sc;
+    } else if (name == "D") {
+        sc = ramp("D, the GGX distribution (first light), drawn as D / (1 + D)", "1/sr", "x/(1+x)", 0.0, 0.0);
+        sc.stops = {{0.0, legend(glm::vec3(0.0f))}, {1.0, legend(glm::vec3(1.0f))}};
+        for (double d : {0.0, 0.25, 1.0, 3.0, 9.0}) sc.ticks.push_back({d / (1.0 + d), number(d)});
+        sc.ticks.push_back({1.0, "infinity"});
+    } else return sc;  // final: the picture itself
+    sc.classes.push_back(legend(black, kNoFragment));
+    return sc;
+}
+
+std::string css_colour(const std::uint8_t rgb[3]) {
+    char buf[8];
+    std::snprintf(buf, sizeof buf, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
+    return buf;
+}
+
+nlohmann::json stage_list_json(const FrameSetup& s, const Recording& rec) {
+    using nlohmann::json;
+    json list = json::array();
+    for (const StageInfo& st : stage_list()) {
+        const StageScale sc = stage_scale(s, rec, st.name);
+        json scale = {{"kind", sc.kind}, {"quantity", sc.quantity}, {"units", sc.units}, {"map", sc.map},
+                      {"min", sc.min}, {"max", sc.max}, {"srgb", sc.srgb}, {"channels", sc.channels}};
+        json stops = json::array(), ticks = json::array(), list_classes = json::array();
+        for (const auto& [t, c] : sc.stops) stops.push_back({t, css_colour(c.rgb)});
+        for (const auto& [t, label] : sc.ticks) ticks.push_back({t, label});
+        for (const LegendColour& c : sc.classes) list_classes.push_back({css_colour(c.rgb), c.label});
+        scale["stops"] = stops;
+        scale["ticks"] = ticks;
+        scale["classes"] = list_classes;
+        list.push_back({{"name", st.name}, {"title", st.title}, {"about", st.about}, {"scale", scale}});
+    }
+    return list;
 }
 
 } // namespace prast::stepper

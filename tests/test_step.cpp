@@ -8,7 +8,11 @@
 // (tests/gltf_writer.h): vertex colours, UV set 1 through a NEAREST sampler,
 // a skinned model posed at a time, lines and points, each explained, equal to
 // render's bytes and verified; render --pixel naming step's winner; the
-// frame's environment, ambient and shadows.
+// frame's environment, ambient and shadows. The views (stepper/views.h):
+// draws, draw N, textures, texture ID LEVEL (an 8-bit level's PNG holds the
+// image's bytes), vertices N (clip coordinates recomputed from the camera),
+// the tile filters and the views' JSON, on the built-in scene and a glTF the
+// test writes, with bad input.
 //
 // Regenerate the transcripts only deliberately, after reading the diff:
 //   PRAST_STEP_REGENERATE=1 build/prast_tests -ts=step
@@ -27,6 +31,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scene/camera.h"
 #include "scene/write_image.h"
 #include "tests/cli_util.h"
 #include "tests/gltf_writer.h"
@@ -825,6 +830,281 @@ TEST_CASE("frame: names the environment that lights the frame, the ambient only 
               std::string::npos);
         CHECK(r.out.find("\nambient (") == std::string::npos);
     }
+}
+
+
+// ---- The views: draws, draw N, textures, texture ID [LEVEL], vertices, tile filters.
+
+// The PNG at `path` as stb_image reads it: size, channels as stored, bytes.
+struct PngFile {
+    int width = 0, height = 0, channels = 0;
+    std::vector<std::uint8_t> bytes;
+};
+PngFile load_png(const std::string& path) {
+    PngFile p;
+    unsigned char* data = stbi_load(path.c_str(), &p.width, &p.height, &p.channels, 0);
+    if (data) p.bytes.assign(data, data + std::size_t(p.width) * std::size_t(p.height) * std::size_t(p.channels));
+    stbi_image_free(data);
+    return p;
+}
+
+// The floats of "(a, b, c)" after `key` in `text`.
+std::vector<float> floats_after(const std::string& text, const std::string& key) {
+    std::vector<float> out;
+    const std::size_t at = text.find(key);
+    if (at == std::string::npos) return out;
+    const std::size_t open = text.find('(', at + key.size()), close = text.find(')', open);
+    std::string inside = text.substr(open + 1, close - open - 1);
+    for (std::size_t p = 0; p < inside.size();) {
+        std::size_t used = 0;
+        out.push_back(std::stof(inside.substr(p), &used));
+        p += used;
+        while (p < inside.size() && (inside[p] == ',' || inside[p] == ' ')) ++p;
+    }
+    return out;
+}
+
+TEST_CASE("views: draws, draw, textures, texture and vertices on a small glTF, with exact values") {
+    CliSandbox box;
+    GltfWriter g;
+    const int img = g.image_png(checker_png());
+    const int tex = g.texture(img, 9728 /*NEAREST*/, 9729 /*LINEAR*/, 33071 /*CLAMP*/, 10497);
+    const int mat = add_material(g, {{"name", "checker"},
+                                     {"pbrMetallicRoughness",
+                                      {{"baseColorFactor", {0.5, 0.25, 1, 1}},
+                                       {"baseColorTexture", {{"index", tex}}},
+                                       {"metallicFactor", 0.25},
+                                       {"roughnessFactor", 0.75}}},
+                                     {"emissiveFactor", {0.125, 0.25, 0.5}},
+                                     {"alphaMode", "MASK"},
+                                     {"alphaCutoff", 0.375},
+                                     {"doubleSided", true}});
+    add_quad(g, 0.0f, json::object(), mat);
+    g.scene_of_meshes();
+    const std::string file = write_gltf(box, g, "views.gltf");
+    std::vector<std::string> flags = kQuadView;
+    flags.insert(flags.begin(), file);
+    const CliRun r = run_step(box, flags, "frame\ndraws\ndraw 0\ntextures\ntexture 0\ntexture 0 2\nvertices 0\n");
+    INFO(r.out << r.err);
+    REQUIRE(r.code == 0);
+    CHECK(r.out.find("1 draw, in submission order:\n  draw 0: mesh 0 'quad0', material 0 'checker', 2 triangles, "
+                     "visible (2 set up, 0 culled or degenerate), MASK 0.375, double-sided, PBR narrow (12 varyings)\n") !=
+          std::string::npos);
+    CHECK(r.out.find("  material: base colour (0.5, 0.25, 1, 1), metallic 0.25, roughness 0.75, emissive (0.125, 0.25, "
+                     "0.5)\n    normal scale 1, occlusion strength 1, ior 1.5, alpha MASK 0.375, double-sided\n") !=
+          std::string::npos);
+    CHECK(r.out.find("  map base_color: texture 0, image 0 ") != std::string::npos);
+    CHECK(r.out.find(", 4x4, RGB 8-bit sRGB, 3 mip levels, sampler: mag NEAREST, min LINEAR, wrap clamp/repeat, UV set "
+                     "0\n") != std::string::npos);
+    CHECK(r.out.find("  state: cull none, depth test LESS, depth write on, blend replace, may discard (alpha MASK); "
+                     "shaded in submission order\n") != std::string::npos);
+    CHECK(r.out.find("  light 0: sun towards (0, 0, 1), radiance (1, 1, 1)\n") != std::string::npos);
+    CHECK(r.out.find("  shadows off\n") != std::string::npos);
+    CHECK(r.out.find("1 texture (texture ID [LEVEL] writes a level as a PNG):\n  texture 0: 4x4, 3 levels, RGB 8-bit "
+                     "sRGB\n") != std::string::npos);
+    CHECK(r.out.find("  levels: 0 4x4, 1 2x2, 2 1x1\n") != std::string::npos);
+    CHECK(r.out.find("texture 0 0 -> wrote texture-0-level-0.png\n") != std::string::npos);
+    CHECK(r.out.find("texture 0 2 -> wrote texture-0-level-2.png\n") != std::string::npos);
+    // Level 0's PNG holds the image's own bytes; level 2 is one texel.
+    const PngFile l0 = load_png(box.path("texture-0-level-0.png"));
+    std::vector<std::uint8_t> src;  // checker_png()'s texels, as the decoder gives them
+    const std::uint8_t colours[4][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0}};
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) {
+            const std::uint8_t* c = colours[(y / 2) * 2 + x / 2];
+            src.insert(src.end(), {c[0], c[1], c[2]});
+        }
+    CHECK(l0.width == 4);
+    CHECK(l0.height == 4);
+    CHECK(l0.channels == 3);  // encode_png() writes RGB
+    CHECK(l0.bytes == src);
+    const PngFile l2 = load_png(box.path("texture-0-level-2.png"));
+    CHECK(l2.width == 1);
+    CHECK(l2.height == 1);
+    // The first vertex: its position, and clip coordinates the test recomputes
+    // from the camera `frame` prints (its numbers read back as the same floats).
+    CHECK(r.out.find("vertices of draw 0 (mesh 'quad0'): 4 of 4 vertices from 0\n") != std::string::npos);
+    CHECK(r.out.find("  v0 in: position (-1, -1, 0) normal (0, 0, 1) uv0 (0, 1) tangent (") != std::string::npos);
+    prast::Camera cam;
+    const std::vector<float> eye = floats_after(r.out, "camera eye "), target = floats_after(r.out, " target "),
+                             up = floats_after(r.out, " up ");
+    REQUIRE(eye.size() == 3);
+    cam.eye = {eye[0], eye[1], eye[2]};
+    cam.target = {target[0], target[1], target[2]};
+    cam.up = {up[0], up[1], up[2]};
+    std::smatch m;
+    const std::regex planes("fov ([-0-9.e]+) near ([-0-9.e]+) far ([-0-9.e]+)");
+    REQUIRE(std::regex_search(r.out, m, planes));
+    cam.fov_y_deg = std::stof(m[1]);
+    cam.near_plane = std::stof(m[2]);
+    cam.far_plane = std::stof(m[3]);
+    const glm::vec4 clip = cam.view_projection(48.0f / 36.0f) * glm::vec4(-1.0f, -1.0f, 0.0f, 1.0f);
+    const std::vector<float> got = floats_after(r.out.substr(r.out.find("  v0 in:")), "out: clip ");
+    REQUIRE(got.size() == 4);
+    for (int k = 0; k < 4; ++k) CHECK(got[std::size_t(k)] == clip[k]);
+    const double wx = (double(clip.x) / clip.w + 1.0) * 0.5 * 48, wy = (1.0 - double(clip.y) / clip.w) * 0.5 * 36;
+    const std::vector<float> win = floats_after(r.out.substr(r.out.find("  v0 in:")), " window ");
+    REQUIRE(win.size() == 2);
+    CHECK(std::fabs(win[0] - wx) < 1e-4);
+    CHECK(std::fabs(win[1] - wy) < 1e-4);
+    // The JSON of each view: the same values, and the text under "text".
+    const CliRun js = run_step(box, flags,
+                               "json draws\njson draw 0\njson textures\njson texture 0 1\njson vertices 0 1 2\n"
+                               "json tile 0 0 --summary\n");
+    REQUIRE(js.code == 0);
+    const std::vector<std::string> jl = lines_of(js.out);
+    REQUIRE(jl.size() == 6);
+    const json draws = json::parse(jl[0]), draw = json::parse(jl[1]), textures = json::parse(jl[2]),
+               texture = json::parse(jl[3]), vertices = json::parse(jl[4]), tile = json::parse(jl[5]);
+    CHECK(draws["draws"].size() == 1);
+    CHECK(draws["draws"][0]["material_name"] == "checker");
+    CHECK(draws["draws"][0]["drawn"] == 2);
+    CHECK(draws["draws"][0]["alpha"] == "MASK 0.375");
+    CHECK(draws["text"].get<std::string>().find("1 draw, in submission order:\n") == 0);
+    CHECK(draw["state"]["material"]["metallic"] == 0.25);
+    CHECK(draw["state"]["material"]["alpha_cutoff"] == 0.375);
+    CHECK(draw["state"]["material"]["base_color"] == json::array({0.5, 0.25, 1, 1}));
+    CHECK(draw["state"]["maps"][0]["texture"] == "0");
+    CHECK(draw["state"]["maps"][0]["uv_set"] == 0);
+    CHECK(draw["state"]["cull"] == "none");
+    CHECK(textures["textures"][0]["levels"] == 3);
+    CHECK(texture["level"] == 1);
+    CHECK(texture["level_sizes"][1]["width"] == 2);
+    CHECK(texture["colour_space"] == "sRGB");
+    CHECK(texture["png"] == json({{"endpoint", "/api/texture.png"}, {"id", "0"}, {"level", 1}}));
+    CHECK(vertices["vertices"].size() == 2);
+    CHECK(vertices["vertices"][0]["index"] == 1);
+    CHECK(vertices["vertices"][0]["position"] == json::array({1, -1, 0}));
+    CHECK(tile["summary"]["bin_entries"] == 2);
+    CHECK(tile["bins"].empty());
+    // Bad input: one line each, naming the range.
+    const CliRun bad = run_step(box, flags,
+                                "draw 1\ndraw x\ntexture 1\ntexture 0 3\nvertices 1\nvertices 0 4\nvertices 0 0 0\n"
+                                "draw\ntexture\nvertices\ndraws 1\njson frame\njson draw 7\n");
+    CHECK(bad.code == 1);
+    CHECK(bad.out == "error: draw '1': no such draw (draws 0..0)\n"
+                     "error: draw 'x': no such draw (draws 0..0)\n"
+                     "error: texture '1': no such texture (textures 0..0; `textures` lists them)\n"
+                     "error: texture 0 level '3': no such level (levels 0..2)\n"
+                     "error: vertices '1': no such draw (draws 0..0)\n"
+                     "error: vertices 0 '4': no such vertex (draw 0 has vertices 0..3)\n"
+                     "error: vertices 0 0 '0': not a count (1 or more)\n"
+                     "error: usage: draw N (draws lists them)\n"
+                     "error: usage: texture ID [LEVEL [FILE]] (textures lists the IDs)\n"
+                     "error: usage: vertices N [FIRST [COUNT]] (draw N; FIRST 0 and COUNT 16 by default)\n"
+                     "error: draws takes no arguments\n"
+                     "error: usage: json draws | draw N | textures | texture ID [LEVEL] | vertices N [FIRST [COUNT]] | "
+                     "tile X Y [FILTER]\n"
+                     "error: draw '7': no such draw (draws 0..0)\n");
+}
+
+TEST_CASE("views: the built-in scene's draws and maps, its shadow maps and sky as textures, tile filters") {
+    CliSandbox box;
+    const CliRun r = run_step(box, {"--size", "160x90", "--shadows", "on", "--shadow-size", "256"},
+                              "draws\ndraw 24\ntextures\ntexture 0 9\ntexture shadow0\ntexture shadow1\ntexture env 3\n"
+                              "vertices 24 70 1000000\nvertices 0 0 5000\ntile 1 0\ntile 1 0 --summary\n");
+    INFO(r.out << r.err);
+    REQUIRE(r.code == 0);
+    CHECK(r.out.find("25 draws, in submission order:\n  draw 0: mesh 0 'sphere', material 0 'sphere_m0_r0', 4096 "
+                     "triangles, visible (") != std::string::npos);
+    CHECK(r.out.find("  draw 24: mesh 24 'floor', material 24 'tiles', 128 triangles, ") != std::string::npos);
+    // The floor's maps: procedural, float, 512x512 with 10 levels.
+    CHECK(r.out.find("  map base_color: texture 0, image 0 'builtin:tiles_albedo', 512x512, RGBA float32 linear, 10 mip levels, "
+                     "sampler: mag LINEAR, min LINEAR_MIPMAP_LINEAR, wrap repeat/repeat, UV set 0\n") != std::string::npos);
+    CHECK(r.out.find("  shadows on, maps of 256 texels a side (cube faces half that)\n") != std::string::npos);
+    CHECK(r.out.find("shadow map shadow0 (directional, 256x256)") != std::string::npos);
+    CHECK(r.out.find("shadow map shadow1 (cube, 6 faces of 128x128)") != std::string::npos);
+    CHECK(r.out.find("  environment: texture env, 512x256, intensity 1, rotated 0 degrees") != std::string::npos);
+    CHECK(r.out.find("  texture shadow0: 256x256, 1 level, distance float32, directional\n") != std::string::npos);
+    CHECK(r.out.find("  texture shadow1: 128x768, 1 level, distance float32, a cube of 6 faces of 128x128") !=
+          std::string::npos);
+    CHECK(r.out.find("  texture env: 512x256, 8 levels, RGB float32 linear radiance") != std::string::npos);
+    CHECK(r.out.find("texture 0 9 -> wrote texture-0-level-9.png\n") != std::string::npos);
+    CHECK(r.out.find("texture env 3 -> wrote texture-env-level-3.png\n") != std::string::npos);
+    const PngFile floor9 = load_png(box.path("texture-0-level-9.png"));
+    CHECK(floor9.width == 1);
+    CHECK(floor9.channels == 4);
+    const PngFile sun = load_png(box.path("texture-shadow0-level-0.png"));
+    CHECK(sun.width == 256);
+    CHECK(sun.height == 256);
+    CHECK(sun.channels == 1);
+    CHECK(std::count(sun.bytes.begin(), sun.bytes.end(), 0) > 0);  // the ramp reaches black at the nearest caster
+    const std::regex ramp("  distance ([-0-9.e]+) \\(black\\) \\.\\. ([-0-9.e]+) \\(grey 254\\)");
+    std::smatch m;
+    REQUIRE(std::regex_search(r.out, m, ramp));
+    CHECK(std::stof(m[1]) < std::stof(m[2]));
+    const PngFile cube = load_png(box.path("texture-shadow1-level-0.png"));
+    CHECK(cube.width == 128);
+    CHECK(cube.height == 768);
+    const PngFile env3 = load_png(box.path("texture-env-level-3.png"));
+    CHECK(env3.width > 0);
+    CHECK(r.out.find("  levels: 0 512x256, 1 256x128, 2 128x64, 3 64x32,") != std::string::npos);
+    CHECK(env3.width == 64);
+    CHECK(env3.height == 32);
+    // Vertices: from 70 the floor's 81 leave 11 rows; 5000 of a sphere's are capped at 1000, with a note.
+    CHECK(r.out.find("vertices of draw 24 (mesh 'floor'): 11 of 81 vertices from 70\n") != std::string::npos);
+    CHECK(r.out.find("vertices of draw 0 (mesh 'sphere'): 1000 of 2145 vertices from 0 (5000 asked, capped at 1000 "
+                     "rows: ask again with FIRST 1000 for more)\n") != std::string::npos);
+    CHECK(r.out.find("  v999 in: ") != std::string::npos);
+    CHECK(r.out.find("  v1000 in: ") == std::string::npos);
+    // Tiles: the summary first, then the bins; --summary alone.
+    const std::size_t t0 = r.out.find("tile 1 0: pixels x 64..127 y 0..63\n");
+    REQUIRE(t0 != std::string::npos);
+    CHECK(r.out.find("triangles binned (", t0) != std::string::npos);
+    CHECK(r.out.find(" bin entries in the order the tile ran them:\n", t0) != std::string::npos);
+    const std::regex one_plural("[^0-9.]1 (blocks|fragments|triangles|pixels|bin entries|levels)[^a-z]");
+    CHECK(!std::regex_search(r.out, one_plural));
+    CHECK(r.out.find(": 1 block, 1 fragment, ") != std::string::npos);
+    // Bad input.
+    const CliRun bad = run_step(box, {"--size", "160x90"},
+                                "draw 25\ntexture nope\ntexture shadow0\ntexture env 8\ntile 0 0 tri 98432\n"
+                                "tile 0 0 pixel 64 0\ntile 0 0 bogus\ntile 3 0\n");
+    CHECK(bad.code == 1);
+    CHECK(bad.out == "error: draw '25': no such draw (draws 0..24)\n"
+                     "error: texture 'nope': no such texture (textures 0..2, env; `textures` lists them)\n"
+                     "error: texture 'shadow0': no such texture (textures 0..2, env; `textures` lists them)\n"
+                     "error: texture env level '8': no such level (levels 0..7)\n"
+                     "error: tile 0 0 tri '98432': not a triangle number (0..98431)\n"
+                     "error: tile 0 0 pixel '64 0': not in the tile (x 0..63, y 0..63)\n"
+                     "error: usage: tile X Y [tri N | pixel X Y | --summary] (tile column and row)\n"
+                     "error: tile '3 0': outside the 3x2 tiles (columns 0..2, rows 0..1)\n");
+}
+
+TEST_CASE("tile: the filters pick the bins of one triangle and of one pixel, which add up to the summary") {
+    CliSandbox box;
+    const CliRun r = run_step(box, {"--size", "640x360"}, "tile 6 2\npixel 390 190\n");
+    INFO(r.out);
+    REQUIRE(r.code == 0);
+    // The pixel's winning triangle, from pixel's history.
+    const std::regex winner("  #[0-9]+ draw [0-9]+ \\(mesh '[^']*'\\) triangle [0-9]+ \\(frame triangle ([0-9]+)\\)");
+    std::smatch m;
+    REQUIRE(std::regex_search(r.out, m, winner));
+    const std::string tri = m[1];
+    const CliRun f = run_step(box, {"--size", "640x360"}, "tile 6 2 tri " + tri + "\ntile 6 2 pixel 390 190\n");
+    INFO(f.out);
+    REQUIRE(f.code == 0);
+    CHECK(f.out.find(" of tri " + tri + ", in the order the tile ran them:\n  tri " + tri) != std::string::npos);
+    CHECK(f.out.find("    block ") != std::string::npos);
+    CHECK(f.out.find(" of pixel 390 190, in the order the tile ran them:\n") != std::string::npos);
+    CHECK(f.out.find("    block 388 188 lane ") != std::string::npos);
+    CHECK(f.out.find("  tri " + tri) != f.out.rfind("  tri " + tri));  // in both filters
+    // The summary's counts are the sums of the bins' lines.
+    const std::string all = r.out.substr(0, r.out.find("pixel 390 190:"));
+    const std::regex summary("  ([0-9]+) triangles? binned \\(([0-9]+) bin entr(y|ies)\\), ([0-9]+) 4x4 blocks?, ([0-9]+) "
+                             "fragments? covered: ([0-9]+) passed the depth test, ([0-9]+) failed; ([0-9]+) shaded, "
+                             "([0-9]+) written to ([0-9]+) pixels?");
+    REQUIRE(std::regex_search(all, m, summary));
+    const long blocks = std::stol(m[4]), covered = std::stol(m[5]), passed = std::stol(m[6]), failed = std::stol(m[7]);
+    CHECK(covered == passed + failed);
+    CHECK(std::stol(m[10]) <= 64 * 64);
+    long sum_blocks = 0, sum_covered = 0;
+    const std::regex bin("  tri [0-9]+( piece [0-9]+)? \\('[^']*'\\): ([0-9]+) blocks?, ([0-9]+) fragments?,");
+    for (std::sregex_iterator it(all.begin(), all.end(), bin), end; it != end; ++it) {
+        sum_blocks += std::stol((*it)[2]);
+        sum_covered += std::stol((*it)[3]);
+    }
+    CHECK(sum_blocks == blocks);
+    CHECK(sum_covered == covered);
 }
 
 } // TEST_SUITE

@@ -1,83 +1,449 @@
 // The stepper's page: every number comes from the JSON API of the `step`
 // process that served it (the same interpreter as the terminal front end).
+// The view: the frame fitted in the view area, zoomed (wheel around the
+// pointer, +/-), panned (drag, Shift+arrows), with a selected pixel that the
+// arrow keys move and Enter explains.
 "use strict";
 
-const state = { frame: null, stage: "final", upto: null, pixel: null, tile: null, tri: null };
+const state = {
+  frame: null, stages: {}, stage: "final", upto: null,
+  pixel: null,      // the explained pixel [x, y]
+  selected: null,   // the selected pixel (the box), which Enter explains
+  tile: null, tri: null, hover: null,
+};
+// Image pixel (x, y) is drawn at view position (ox + x * s, oy + y * s), CSS px.
+const view = { s: 1, ox: 0, oy: 0, fit: true };
 const $ = (id) => document.getElementById(id);
+const GRID_ZOOM = 8;    // device pixels per image pixel from which the pixel grid shows
+const MAX_ZOOM = 128;
+
+const SERVER_GONE = "the step server stopped (or cannot be reached): restart `step [SCENE] [flags] --serve` and " +
+  "reload this page. What is already shown stays usable (zoom, pan, the texts below).";
+
+class ServerGone extends Error { constructor() { super(SERVER_GONE); } }
 
 async function api(path) {
-  const r = await fetch(path);
-  const body = await r.json();
+  let r;
+  try {
+    r = await fetch(path);
+  } catch (e) {
+    throw new ServerGone();
+  }
+  let body;
+  try {
+    body = await r.json();
+  } catch (e) {
+    throw new Error(path + ": the server's answer is not JSON (status " + r.status + ")");
+  }
   if (!r.ok) throw new Error(body.error || r.statusText);
   return body;
 }
 
 function status(text) { $("status").textContent = text || ""; }
 
+// ---------------------------------------------------------------- the image
+
 function imageUrl() {
   if (state.upto !== null) return "/api/upto?n=" + state.upto;
   return "/api/stage?name=" + encodeURIComponent(state.stage);
 }
 
+// The displayed image's pixels, for the value under the pointer.
+const pixels = { canvas: document.createElement("canvas"), ctx: null, ready: false };
+
+let imageRequest = 0;
+let shown = { stage: "final", upto: null };  // what the displayed image is
+// Loads the image first and swaps it in when it arrived, so that a failed
+// load (a stopped server) keeps the last image on screen, and the controls
+// go back to what it shows.
 function showImage() {
-  status("drawing...");
-  $("image").src = imageUrl();
+  const url = imageUrl(), ticket = ++imageRequest, want = { stage: state.stage, upto: state.upto };
+  const loader = new Image();
+  $("view").classList.add("loading");
+  loader.onload = () => {
+    if (ticket !== imageRequest) return;
+    const img = $("image");
+    img.src = url;
+    shown = want;
+    const c = pixels.canvas;
+    c.width = loader.naturalWidth;
+    c.height = loader.naturalHeight;
+    pixels.ctx = c.getContext("2d", { willReadFrequently: true });
+    pixels.ctx.drawImage(loader, 0, 0);
+    pixels.ready = true;
+    $("view").classList.remove("loading");
+    status("");
+    placeImage();
+    showValue();
+  };
+  loader.onerror = async () => {
+    if (ticket !== imageRequest) return;
+    $("view").classList.remove("loading");
+    if ($("image").src) {
+      state.stage = shown.stage;
+      state.upto = shown.upto;
+      showControls();
+    }
+    try {
+      await api("/api/frame");
+      status("the image " + url + " could not be drawn");
+    } catch (e) { showError(e); }
+  };
+  loader.src = url;
 }
 
-function drawOverlay() {
-  const img = $("image"), c = $("overlay"), f = state.frame;
+function showError(e) { status(e.message); }
+
+// The stage list, the slider, the sentence and the legend for state.stage and state.upto.
+function showControls() {
+  $("stage").value = state.stage;
+  const up = $("upto");
+  up.value = state.upto === null ? up.max : state.upto;
+  $("upto-value").textContent = state.upto === null ? "all" : String(state.upto);
+  $("stage-about").textContent = state.upto !== null
+    ? "The frame after the first " + state.upto + " triangles in submission order, drawn by the real pipeline."
+    : state.stages[state.stage].about;
+  showLegend();
+  updatePixelNote();
+}
+
+// ---------------------------------------------------------------- view transform
+
+// The view's inner size in CSS px, fractions kept (clientWidth rounds).
+function viewSize() {
+  const v = $("view"), r = v.getBoundingClientRect(), cs = getComputedStyle(v);
+  const bx = parseFloat(cs.borderLeftWidth) + parseFloat(cs.borderRightWidth);
+  const by = parseFloat(cs.borderTopWidth) + parseFloat(cs.borderBottomWidth);
+  return [r.width - bx, r.height - by];
+}
+
+function fitScale() {
+  const [w, h] = viewSize(), f = state.frame;
+  return Math.min(w / f.width, h / f.height);
+}
+
+function minScale() { return Math.min(fitScale(), 1) / 4; }
+
+function fitView() {
+  const [w, h] = viewSize(), f = state.frame;
+  view.s = fitScale();
+  view.ox = (w - f.width * view.s) / 2;
+  view.oy = (h - f.height * view.s) / 2;
+  view.fit = true;
+  placeImage();
+}
+
+// Keeps some of the image in the view.
+function clampPan() {
+  const [w, h] = viewSize(), f = state.frame, keep = 32;
+  view.ox = Math.min(w - keep, Math.max(keep - f.width * view.s, view.ox));
+  view.oy = Math.min(h - keep, Math.max(keep - f.height * view.s, view.oy));
+}
+
+// Zooms by `factor` keeping view point (cx, cy) on the same image point.
+function zoomAt(cx, cy, factor) {
+  const s = Math.min(MAX_ZOOM, Math.max(minScale(), view.s * factor));
+  view.ox = cx - (cx - view.ox) * s / view.s;
+  view.oy = cy - (cy - view.oy) * s / view.s;
+  view.s = s;
+  view.fit = false;
+  clampPan();
+  placeImage();
+}
+
+// The zoom centre for keys and buttons: the selected pixel when it is in
+// the view, else the view's centre.
+function zoomCentre() {
+  const [w, h] = viewSize();
+  if (state.selected) {
+    const x = view.ox + (state.selected[0] + 0.5) * view.s, y = view.oy + (state.selected[1] + 0.5) * view.s;
+    if (x >= 0 && y >= 0 && x < w && y < h) return [x, y];
+  }
+  return [w / 2, h / 2];
+}
+
+function zoomBy(factor) {
+  const [cx, cy] = zoomCentre();
+  zoomAt(cx, cy, factor);
+}
+
+function oneToOne() {
+  const [cx, cy] = zoomCentre();
+  zoomAt(cx, cy, 1 / (window.devicePixelRatio || 1) / view.s);
+}
+
+function panBy(dx, dy) {
+  view.ox += dx;
+  view.oy += dy;
+  view.fit = false;
+  clampPan();
+  placeImage();
+}
+
+function placeImage() {
+  const f = state.frame;
   if (!f) return;
-  c.width = img.clientWidth;
-  c.height = img.clientHeight;
-  const sx = img.clientWidth / f.width, sy = img.clientHeight / f.height;
+  const img = $("image");
+  img.style.left = view.ox + "px";
+  img.style.top = view.oy + "px";
+  img.style.width = f.width * view.s + "px";
+  img.style.height = f.height * view.s + "px";
+  const dpr = window.devicePixelRatio || 1;
+  $("zoom-value").textContent = (view.s * dpr >= 10 ? Math.round(view.s * dpr) : (view.s * dpr).toPrecision(2)) +
+    "x" + (view.fit ? " (fit)" : "");
+  drawOverlay();
+}
+
+// The image pixel under a pointer event, or null outside the image.
+function pixelAt(ev) {
+  const v = $("view"), r = v.getBoundingClientRect(), f = state.frame;
+  const vx = ev.clientX - r.left - v.clientLeft, vy = ev.clientY - r.top - v.clientTop;
+  const x = Math.floor((vx - view.ox) / view.s), y = Math.floor((vy - view.oy) / view.s);
+  if (x < 0 || y < 0 || x >= f.width || y >= f.height) return null;
+  return [x, y];
+}
+
+function viewPoint(ev) {
+  const v = $("view"), r = v.getBoundingClientRect();
+  return [ev.clientX - r.left - v.clientLeft, ev.clientY - r.top - v.clientTop];
+}
+
+// ---------------------------------------------------------------- overlay
+
+function drawOverlay() {
+  const f = state.frame, c = $("overlay");
+  if (!f) return;
+  const [w, h] = viewSize(), dpr = window.devicePixelRatio || 1;
+  if (c.width !== Math.round(w * dpr) || c.height !== Math.round(h * dpr)) {
+    c.width = Math.round(w * dpr);
+    c.height = Math.round(h * dpr);
+    c.style.width = w + "px";
+    c.style.height = h + "px";
+  }
   const g = c.getContext("2d");
-  g.clearRect(0, 0, c.width, c.height);
-  if ($("grid").checked) {
-    g.strokeStyle = "rgba(255,255,255,0.35)";
+  g.setTransform(dpr, 0, 0, dpr, 0, 0);
+  g.clearRect(0, 0, w, h);
+  const s = view.s, X = (x) => view.ox + x * s, Y = (y) => view.oy + y * s;
+  // The visible range of image pixels.
+  const x0 = Math.max(0, Math.floor(-view.ox / s)), x1 = Math.min(f.width, Math.ceil((w - view.ox) / s));
+  const y0 = Math.max(0, Math.floor(-view.oy / s)), y1 = Math.min(f.height, Math.ceil((h - view.oy) / s));
+  if (s * dpr >= GRID_ZOOM) {
+    g.strokeStyle = "rgba(128,128,128,0.45)";
+    g.lineWidth = 1 / dpr;
     g.beginPath();
-    for (let x = 0; x <= f.width; x += f.tile_size) { g.moveTo(x * sx + 0.5, 0); g.lineTo(x * sx + 0.5, c.height); }
-    for (let y = 0; y <= f.height; y += f.tile_size) { g.moveTo(0, y * sy + 0.5); g.lineTo(c.width, y * sy + 0.5); }
+    for (let x = x0; x <= x1; ++x) { g.moveTo(X(x), Y(y0)); g.lineTo(X(x), Y(y1)); }
+    for (let y = y0; y <= y1; ++y) { g.moveTo(X(x0), Y(y)); g.lineTo(X(x1), Y(y)); }
+    g.stroke();
+  }
+  if ($("grid").checked) {
+    g.strokeStyle = "rgba(255,255,255,0.5)";
+    g.lineWidth = 1;
+    g.beginPath();
+    for (let x = 0; x <= f.width; x += f.tile_size) { g.moveTo(X(x), Y(0)); g.lineTo(X(x), Y(f.height)); }
+    for (let y = 0; y <= f.height; y += f.tile_size) { g.moveTo(X(0), Y(y)); g.lineTo(X(f.width), Y(y)); }
     g.stroke();
   }
   if (state.tile) {
     g.strokeStyle = "#ff0";
     g.lineWidth = 2;
-    g.strokeRect(state.tile[0] * f.tile_size * sx, state.tile[1] * f.tile_size * sy, f.tile_size * sx, f.tile_size * sy);
-    g.lineWidth = 1;
+    const tx = state.tile[0] * f.tile_size, ty = state.tile[1] * f.tile_size;
+    const tw = Math.min(f.width, tx + f.tile_size) - tx, th = Math.min(f.height, ty + f.tile_size) - ty;
+    g.strokeRect(X(tx), Y(ty), tw * s, th * s);
   }
+  // The box first: the triangle's outline is drawn over it, never hidden.
+  if (state.selected) drawBox(g, state.selected);
   if (state.tri) {
+    g.lineWidth = 1.5;
+    g.strokeStyle = "#0ff";
     for (const p of state.tri.pieces) {
       if (!p.window) continue;
-      g.strokeStyle = "#0ff";
       g.beginPath();
-      p.window.forEach((v, i) => (i ? g.lineTo(v[0] * sx, v[1] * sy) : g.moveTo(v[0] * sx, v[1] * sy)));
+      p.window.forEach((v, i) => (i ? g.lineTo(X(v[0]), Y(v[1])) : g.moveTo(X(v[0]), Y(v[1]))));
       g.closePath();
       g.stroke();
     }
   }
-  if (state.pixel) {
-    const x = (state.pixel[0] + 0.5) * sx, y = (state.pixel[1] + 0.5) * sy;
-    g.strokeStyle = "#f0f";
-    g.beginPath();
-    g.moveTo(x - 8, y); g.lineTo(x - 2, y); g.moveTo(x + 2, y); g.lineTo(x + 8, y);
-    g.moveTo(x, y - 8); g.lineTo(x, y - 2); g.moveTo(x, y + 2); g.lineTo(x, y + 8);
-    g.stroke();
-  }
 }
 
+// A hollow box around the pixel (at least 9 px across) with ticks pointing
+// at it from outside: the pixel itself stays visible.
+function drawBox(g, p) {
+  const s = view.s, cx = view.ox + (p[0] + 0.5) * s, cy = view.oy + (p[1] + 0.5) * s;
+  const half = Math.max(4.5, s / 2 + 2);
+  const ticks = (ctx) => {
+    ctx.beginPath();
+    ctx.rect(cx - half, cy - half, 2 * half, 2 * half);
+    ctx.moveTo(cx - half - 7, cy); ctx.lineTo(cx - half - 1, cy);
+    ctx.moveTo(cx + half + 1, cy); ctx.lineTo(cx + half + 7, cy);
+    ctx.moveTo(cx, cy - half - 7); ctx.lineTo(cx, cy - half - 1);
+    ctx.moveTo(cx, cy + half + 1); ctx.lineTo(cx, cy + half + 7);
+    ctx.stroke();
+  };
+  g.lineWidth = 2.5;
+  g.strokeStyle = "rgba(0,0,0,0.7)";
+  ticks(g);
+  g.lineWidth = 1;
+  g.strokeStyle = "#f0f";
+  ticks(g);
+}
+
+// ---------------------------------------------------------------- legend and values
+
+function el(tag, cls, text) {
+  const e = document.createElement(tag);
+  if (cls) e.className = cls;
+  if (text !== undefined) e.textContent = text;
+  return e;
+}
+
+function currentScale() {
+  if (state.upto !== null) return null;
+  const st = state.stages[state.stage];
+  return st && st.scale ? st.scale : null;
+}
+
+function showLegend() {
+  const box = $("legend"), sc = currentScale();
+  box.textContent = "";
+  if (!sc || sc.kind === "picture") return;
+  const lg = el("div", "legend");
+  lg.id = "legend-" + state.stage;
+  lg.appendChild(el("div", "quantity", sc.quantity + (sc.units ? " (" + sc.units + ")" : "")));
+  if (sc.kind === "ramp") {
+    const bar = el("div", "bar");
+    bar.style.background = "linear-gradient(to right, " +
+      sc.stops.map(([t, c]) => c + " " + (t * 100) + "%").join(", ") + ")";
+    lg.appendChild(bar);
+    const ticks = el("div", "ticks");
+    for (const [t, label] of sc.ticks) {
+      const sp = el("span", t < 0.05 ? "start" : t > 0.95 ? "end" : "", label);
+      sp.style.left = (t * 100) + "%";
+      ticks.appendChild(sp);
+    }
+    lg.appendChild(ticks);
+  } else if (sc.kind === "channels") {
+    ["#ff0000", "#00ff00", "#0000ff"].forEach((hue, k) => {
+      if (k >= sc.channels.length) return;
+      const ch = el("span", "channel");
+      ch.appendChild(el("span", "name", sc.channels[k]));
+      const bar = el("span", "bar");
+      bar.style.background = "linear-gradient(to right, #000000, " + hue + ")";
+      ch.appendChild(bar);
+      ch.appendChild(el("span", "", sc.min + " .. " + sc.max));
+      lg.appendChild(ch);
+    });
+    lg.appendChild(el("span", "", sc.srgb ? "(sRGB-encoded)" : "(linear)"));
+  }
+  if (sc.classes.length) {
+    const cl = el("div", "classes");
+    for (const [c, label] of sc.classes) {
+      const sp = el("span");
+      const sw = el("i");
+      sw.style.background = c;
+      sp.appendChild(sw);
+      sp.appendChild(document.createTextNode(label));
+      cl.appendChild(sp);
+    }
+    lg.appendChild(cl);
+  }
+  box.appendChild(lg);
+}
+
+const hex = (rgb) => "#" + rgb.map((v) => v.toString(16).padStart(2, "0")).join("");
+const srgbToLinear = (v) => (v <= 0.04045 ? v / 12.92 : Math.pow((v + 0.055) / 1.055, 2.4));
+
+function rampColour(sc, t) {
+  const stops = sc.stops;
+  let i = 0;
+  while (i + 2 < stops.length && t > stops[i + 1][0]) ++i;
+  const [t0, c0] = stops[i], [t1, c1] = stops[i + 1];
+  const u = t1 > t0 ? Math.min(1, Math.max(0, (t - t0) / (t1 - t0))) : 0;
+  const a = parseInt(c0.slice(1), 16), b = parseInt(c1.slice(1), 16);
+  return [16, 8, 0].map((sh) => ((a >> sh) & 255) * (1 - u) + ((b >> sh) & 255) * u);
+}
+
+function rampValue(sc, t) {
+  if (sc.map === "log") return Math.pow(2, Math.log2(sc.min) + t * (Math.log2(sc.max) - Math.log2(sc.min)));
+  if (sc.map === "log1p") return Math.pow(1 + sc.max, t) - 1;
+  if (sc.map === "x/(1+x)") return t < 1 ? t / (1 - t) : Infinity;
+  return sc.min + t * (sc.max - sc.min);
+}
+
+// What the stage's scale says a displayed colour means ("" when nothing).
+function readScale(sc, rgb) {
+  if (!sc) return "";
+  const h = hex(rgb);
+  for (const [c, label] of sc.classes) if (c === h) return label;
+  if (sc.kind === "ramp") {
+    let best = 1e9, bt = 0;
+    for (let i = 0; i <= 1024; ++i) {
+      const c = rampColour(sc, i / 1024);
+      const d = (c[0] - rgb[0]) ** 2 + (c[1] - rgb[1]) ** 2 + (c[2] - rgb[2]) ** 2;
+      if (d < best) { best = d; bt = i / 1024; }
+    }
+    if (best > 48) return "not on the scale";
+    const v = rampValue(sc, bt);
+    return "about " + (isFinite(v) ? v.toPrecision(3) : "infinity") + (sc.units ? " " + sc.units : "") +
+      " (read from the colour bar)";
+  }
+  if (sc.kind === "channels") {
+    return sc.channels.map((name, k) => {
+      const u = sc.srgb ? srgbToLinear(rgb[k] / 255) : rgb[k] / 255;
+      return name + " " + (sc.min + u * (sc.max - sc.min)).toFixed(3);
+    }).join(", ") + " (from the 8-bit colour)";
+  }
+  return "";
+}
+
+// The pixel under the pointer (else the selected one): coordinates, the
+// displayed colour read back from the PNG, and what the legend makes of it.
+function showValue() {
+  const p = state.hover || state.selected, out = $("cursor-value");
+  if (!p) { out.textContent = "move the pointer over the image"; return; }
+  let text = (state.hover ? "" : "selected ") + "x " + p[0] + " y " + p[1];
+  if (pixels.ready && p[0] < pixels.canvas.width && p[1] < pixels.canvas.height) {
+    const d = pixels.ctx.getImageData(p[0], p[1], 1, 1).data, rgb = [d[0], d[1], d[2]];
+    text += "  displayed colour (" + rgb.join(", ") + ") " + hex(rgb);
+    const meaning = readScale(currentScale(), rgb);
+    if (meaning) text += "  = " + meaning;
+  }
+  out.textContent = text;
+}
+
+// ---------------------------------------------------------------- panels
+
 function triLink(n) {
-  const a = document.createElement("a");
-  a.className = "tri";
-  a.textContent = "tri " + n;
-  a.addEventListener("click", () => showTriangle(n));
+  const a = el("a", "tri", "tri " + n);
+  a.addEventListener("click", () => showTriangle(n, true));
   return a;
 }
 
+// Scrolls the right column (only it) so that the panel's top shows.
+function revealPanel(id) {
+  const panel = $(id), right = $("right");
+  panel.open = true;
+  const d = panel.getBoundingClientRect().top - right.getBoundingClientRect().top;
+  right.scrollTop += d - 4;
+}
+
+function updatePixelNote() {
+  const f = state.frame, note = $("pixel-note");
+  if (state.pixel && state.upto !== null)
+    note.textContent = "Explained at the end of the frame (all " + f.triangles + " triangles), not at the slider's " +
+      state.upto + ": the server explains a pixel only for the whole frame.";
+  else note.textContent = "";
+}
+
+let pixelRequest = 0;
 async function showPixel(x, y) {
-  state.pixel = [x, y];
-  $("pixel-coords").textContent = x + " " + y;
+  const ticket = ++pixelRequest;
+  state.selected = [x, y];
+  drawOverlay();
   try {
     const p = await api("/api/pixel?x=" + x + "&y=" + y);
+    if (ticket !== pixelRequest) return;
+    state.pixel = [x, y];
+    $("pixel-coords").textContent = x + " " + y;
     const body = $("history").querySelector("tbody");
     body.textContent = "";
     p.history.forEach((h, i) => {
@@ -93,9 +459,9 @@ async function showPixel(x, y) {
     });
     showSamples(p);
     $("pixel-text").textContent = p.text;
+    updatePixelNote();
     status("");
-  } catch (e) { status(e.message); }
-  drawOverlay();
+  } catch (e) { showError(e); }
 }
 
 // The pixel's samples: where each lies in the pixel (the square), which
@@ -113,14 +479,9 @@ function showSamples(p) {
     const holds = s.owner < 0 ? "cleared" : "#" + (s.owner + 1) + " (tri " + p.history[s.owner].tri + ")";
     const tr = document.createElement("tr");
     const offset = "(" + s.offset[0] + ", " + s.offset[1] + ")";
-    [String(k), offset, holds, s.depth.toPrecision(7)].forEach((t) => {
-      const td = document.createElement("td");
-      td.textContent = t;
-      tr.appendChild(td);
-    });
+    [String(k), offset, holds, s.depth.toPrecision(7)].forEach((t) => tr.appendChild(el("td", "", t)));
     const td = document.createElement("td");
-    const sw = document.createElement("span");
-    sw.className = "swatch";
+    const sw = el("span", "swatch");
     sw.style.background = rgb;
     td.appendChild(sw);
     td.appendChild(document.createTextNode("(" + s.color.map((v) => v.toPrecision(6)).join(", ") + ")"));
@@ -135,37 +496,137 @@ function showSamples(p) {
     g.stroke();
     g.fillStyle = "#fff";
     g.font = "10px sans-serif";
-    g.fillText("s" + k, x + n / 12, y + 4);
+    g.fillText("s" + k, x > n * 0.7 ? x - n / 12 - 12 : x + n / 12, y + 4);  // inside the square
   });
 }
 
 async function showTile(tx, ty) {
-  state.tile = [tx, ty];
-  $("tile-coords").textContent = tx + " " + ty;
   try {
     const t = await api("/api/tile?x=" + tx + "&y=" + ty);
+    state.tile = [tx, ty];
+    drawOverlay();
+    $("tile-coords").textContent = tx + " " + ty;
     $("tile-text").textContent = t.text;
     status("");
-  } catch (e) { status(e.message); }
-  drawOverlay();
+  } catch (e) { showError(e); }
 }
 
-async function showTriangle(n) {
+async function showTriangle(n, reveal) {
   $("tri").value = n;
   try {
     state.tri = await api("/api/tri?n=" + n);
+    $("tri-coords").textContent = String(n);
     $("tri-text").textContent = state.tri.text;
     status("");
-  } catch (e) { state.tri = null; status(e.message); }
+    if (reveal) revealPanel("tri-panel");
+  } catch (e) { showError(e); }
   drawOverlay();
 }
 
-function pixelAt(ev) {
-  const img = $("image"), r = img.getBoundingClientRect(), f = state.frame;
-  const x = Math.floor((ev.clientX - r.left - img.clientLeft) * f.width / img.clientWidth);
-  const y = Math.floor((ev.clientY - r.top - img.clientTop) * f.height / img.clientHeight);
-  return [Math.min(f.width - 1, Math.max(0, x)), Math.min(f.height - 1, Math.max(0, y))];
+function explain(x, y) {
+  const ts = state.frame.tile_size;
+  if ($("mode").value === "tile") {
+    state.selected = [x, y];
+    showTile(Math.floor(x / ts), Math.floor(y / ts));
+  } else {
+    showPixel(x, y);
+    showTile(Math.floor(x / ts), Math.floor(y / ts));
+  }
 }
+
+// ---------------------------------------------------------------- input
+
+const drag = { down: false, moved: false, x: 0, y: 0, id: null };
+
+function onPointerDown(ev) {
+  if (!state.frame || ev.button !== 0) return;
+  drag.down = true;
+  drag.moved = false;
+  drag.x = ev.clientX;
+  drag.y = ev.clientY;
+  drag.id = ev.pointerId;
+  $("view").setPointerCapture(ev.pointerId);
+  $("view").focus({ preventScroll: true });
+}
+
+function onPointerMove(ev) {
+  if (!state.frame) return;
+  if (drag.down) {
+    const dx = ev.clientX - drag.x, dy = ev.clientY - drag.y;
+    if (!drag.moved && dx * dx + dy * dy > 16) {
+      drag.moved = true;
+      $("view").classList.add("dragging");
+    }
+    if (drag.moved) {
+      drag.x = ev.clientX;
+      drag.y = ev.clientY;
+      panBy(dx, dy);
+    }
+  }
+  state.hover = pixelAt(ev);
+  showValue();
+}
+
+function onPointerUp(ev) {
+  if (!drag.down) return;
+  drag.down = false;
+  $("view").classList.remove("dragging");
+  if ($("view").hasPointerCapture(ev.pointerId)) $("view").releasePointerCapture(ev.pointerId);
+  if (drag.moved) return;
+  const p = pixelAt(ev);
+  if (p) explain(p[0], p[1]);
+}
+
+function onWheel(ev) {
+  if (!state.frame) return;
+  ev.preventDefault();
+  // One notch (100 px of deltaY) is a factor of sqrt(2); lines and pages count as notches.
+  const delta = ev.deltaMode === 0 ? ev.deltaY : ev.deltaY * 100 / (ev.deltaMode === 1 ? 3 : 1);
+  const [cx, cy] = viewPoint(ev);
+  zoomAt(cx, cy, Math.pow(2, -delta / 200));
+}
+
+// Pans so that the selected pixel's box is inside the view.
+function followSelected() {
+  const [w, h] = viewSize(), p = state.selected, s = view.s, m = Math.max(12, s);
+  const x = view.ox + (p[0] + 0.5) * s, y = view.oy + (p[1] + 0.5) * s;
+  let dx = 0, dy = 0;
+  if (x < m) dx = m - x; else if (x > w - m) dx = w - m - x;
+  if (y < m) dy = m - y; else if (y > h - m) dy = h - m - y;
+  if (dx || dy) panBy(dx, dy); else drawOverlay();
+}
+
+function onKey(ev) {
+  if (!state.frame || ev.altKey || ev.ctrlKey || ev.metaKey) return;
+  const f = state.frame, arrows = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] };
+  const [w, h] = viewSize();
+  if (ev.key in arrows) {
+    const [dx, dy] = arrows[ev.key];
+    if (ev.shiftKey) panBy(-dx * w / 8, -dy * h / 8);
+    else {
+      const p = state.selected || [Math.floor(f.width / 2), Math.floor(f.height / 2)];
+      state.selected = [Math.min(f.width - 1, Math.max(0, p[0] + dx)), Math.min(f.height - 1, Math.max(0, p[1] + dy))];
+      state.hover = null;
+      followSelected();
+      showValue();
+    }
+  } else if (ev.key === "Enter") {
+    if (state.selected) explain(state.selected[0], state.selected[1]);
+  } else if (ev.key === "+" || ev.key === "=") zoomBy(2);
+  else if (ev.key === "-" || ev.key === "_") zoomBy(0.5);
+  else if (ev.key === "f" || ev.key === "F" || ev.key === "0") fitView();
+  else if (ev.key === "1") oneToOne();
+  else return;
+  ev.preventDefault();
+}
+
+function onResize() {
+  if (!state.frame) return;
+  if (view.fit) fitView();
+  else { clampPan(); placeImage(); }
+}
+
+// ---------------------------------------------------------------- start
 
 async function start() {
   try {
@@ -178,35 +639,39 @@ async function start() {
     $("tri").max = f.triangles - 1;
     const sel = $("stage");
     for (const s of stages) {
+      state.stages[s.name] = s;
       const o = document.createElement("option");
       o.value = s.name;
       o.textContent = s.title;
-      o.dataset.about = s.about;
       sel.appendChild(o);
     }
-    sel.value = "final";
-    $("stage-about").textContent = sel.selectedOptions[0].dataset.about;
-    const up = $("upto");
-    up.max = f.triangles;
-    up.value = f.triangles;
+    $("upto").max = f.triangles;
+    showControls();
+    fitView();
     showImage();
-  } catch (e) { status("cannot load the recording: " + e.message); }
+  } catch (e) {
+    showError(e);
+    if (!(e instanceof ServerGone)) status("cannot load the recording: " + e.message);
+  }
 }
 
-$("image").addEventListener("load", () => { status(""); drawOverlay(); });
-$("image").addEventListener("error", () => status("the image could not be drawn"));
-$("image").addEventListener("click", (ev) => {
-  if (!state.frame) return;
-  const [x, y] = pixelAt(ev);
-  if ($("mode").value === "tile") showTile(Math.floor(x / state.frame.tile_size), Math.floor(y / state.frame.tile_size));
-  else { showPixel(x, y); showTile(Math.floor(x / state.frame.tile_size), Math.floor(y / state.frame.tile_size)); }
-});
+const v = $("view");
+v.addEventListener("pointerdown", onPointerDown);
+v.addEventListener("pointermove", onPointerMove);
+v.addEventListener("pointerup", onPointerUp);
+v.addEventListener("pointercancel", onPointerUp);
+v.addEventListener("pointerleave", () => { state.hover = null; showValue(); });
+v.addEventListener("wheel", onWheel, { passive: false });
+v.addEventListener("keydown", onKey);
+new ResizeObserver(onResize).observe(v);
+$("fit").addEventListener("click", () => state.frame && fitView());
+$("one").addEventListener("click", () => state.frame && oneToOne());
+$("zoom-in").addEventListener("click", () => state.frame && zoomBy(2));
+$("zoom-out").addEventListener("click", () => state.frame && zoomBy(0.5));
 $("stage").addEventListener("change", () => {
   state.stage = $("stage").value;
   state.upto = null;
-  $("upto").value = $("upto").max;
-  $("upto-value").textContent = "all";
-  $("stage-about").textContent = $("stage").selectedOptions[0].dataset.about;
+  showControls();
   showImage();
 });
 let uptoTimer = null;
@@ -216,13 +681,11 @@ $("upto").addEventListener("input", () => {
   clearTimeout(uptoTimer);
   uptoTimer = setTimeout(() => {
     state.upto = n === Number($("upto").max) ? null : n;
-    if (state.upto !== null) $("stage-about").textContent =
-      "The frame after the first " + n + " triangles in submission order, drawn by the real pipeline.";
+    showControls();
     showImage();
   }, 150);
 });
 $("grid").addEventListener("change", drawOverlay);
-$("tri-go").addEventListener("click", () => showTriangle(Number($("tri").value)));
-$("tri").addEventListener("keydown", (ev) => { if (ev.key === "Enter") showTriangle(Number($("tri").value)); });
-window.addEventListener("resize", drawOverlay);
+$("tri-go").addEventListener("click", () => showTriangle(Number($("tri").value), false));
+$("tri").addEventListener("keydown", (ev) => { if (ev.key === "Enter") showTriangle(Number($("tri").value), false); });
 start();

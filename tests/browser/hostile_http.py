@@ -14,18 +14,35 @@ run(port) asserts, against a running server:
 - limits: idle and stalled connections are closed by the server, a
   connection serves at most 20 requests, slow clients trickling bytes do not
   stop others from being served, many connections at once are all answered;
+- floods (docs/security.md): a Range header (2,700 ranges, or one) is
+  refused with 416, never a partial or multiplied body; a head of 100,000
+  header lines is refused with 431 after 16 KiB and the server's memory
+  (VmRSS) stays within a few MB; a page load is answered while 64 slow-loris
+  connections and 1,000 idle ones are open, and the slow-loris ones are cut
+  at the deadline; a burst of 200 connections is answered; clients that
+  pipeline requests and read no answer hold no worker; running out of
+  descriptors (the server's limit lowered with prlimit) neither stops nor
+  spins it; a second `step --serve` on the same port fails naming the port;
 - a seeded fuzz loop of a few thousand random and mutated requests;
 - the listening socket is 127.0.0.1's only (/proc/net/tcp, and connecting
   through this machine's other addresses is refused).
-Standard library only.
+The server's process is found from its listening socket (/proc/net/tcp
+inode -> /proc/PID/fd). Standard library only.
 """
 import json
+import os
 import random
+import resource
+import select
 import socket
+import subprocess
 import threading
 import time
 
-KEEP_ALIVE_REQUESTS = 20  # stepper/http_server.cpp kKeepAliveRequests
+KEEP_ALIVE_REQUESTS = 20  # stepper/http_connections.h kKeepAliveRequests
+REQUEST_DEADLINE = 5.0    # kRequestDeadline: a whole request head, from its first byte
+MAX_HEADER_LINES = 100    # stepper/http_wire.h kMaxHeaderLines
+MAX_HEAD_BYTES = 16384    # kMaxHeadBytes
 BUILT_IN = {"/": "text/html; charset=utf-8", "/index.html": "text/html; charset=utf-8",
             "/step.js": "text/javascript; charset=utf-8", "/step.css": "text/css; charset=utf-8"}
 
@@ -63,7 +80,7 @@ def exchange(port, data, timeout=60, head=False, quiet=0.05):
     until it has been quiet for `quiet` seconds after a complete answer (a
     connection the server keeps alive); none when it closed without one,
     several when the bytes held several requests. (Our side stays open: a
-    half-closed client gets no answer from httplib.)"""
+    half-closed client may get no answer.)"""
     reply, reset = b"", False
     with socket.create_connection(("127.0.0.1", port), timeout=timeout) as c:
         try:
@@ -290,10 +307,9 @@ def malformed_checks(port):
     for data in (b"GET /api/frame HTTP/1.1\r\nHost: 127.0.0.1\r\n", b"GET /api/fr", b"\r\n", b"G"):
         for a in exchange(port, data):
             check_error(data, a, range(400, 500))
-    # Many small headers (httplib 0.11 has no count limit): answered, the
-    # server survives; the Host check still holds.
+    # Many small headers: refused with 431 (more below, in flood_checks).
     flood = b"GET /api/frame HTTP/1.1\r\nHost: 127.0.0.1\r\n" + b"X-A: b\r\n" * 5000 + b"\r\n"
-    assert exchange(port, flood)[0][0] == 200
+    check_error("5000 header lines", exchange(port, flood)[0], (431,))
     return len(cases) + 6
 
 
@@ -356,19 +372,26 @@ def slow_client_checks(port):
     # Trickling clients (a header byte every 0.3 s, below the read timeout)
     # hold a worker each; with fewer of them than workers, others are served
     # while all of them are still connected and trickling.
+    # The whole head has a deadline (5 s from its first byte): a trickling
+    # client may be cut then, never before.
     stop = threading.Event()
     lock = threading.Lock()
     trickling, cut_early = [0], []
 
     def trickle():
         with socket.create_connection(("127.0.0.1", port), timeout=60) as c:
+            start = time.monotonic()
             c.sendall(b"GET /api/frame HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ")
             sent = 0
             while not stop.is_set():
                 try:
                     c.sendall(b"z")
                 except (BrokenPipeError, ConnectionResetError):
-                    cut_early.append(sent)
+                    if time.monotonic() - start < REQUEST_DEADLINE:
+                        cut_early.append(sent)
+                    if sent < 3:  # counted as trickling all the same
+                        with lock:
+                            trickling[0] += 1
                     return
                 sent += 1
                 if sent == 3:
@@ -388,7 +411,7 @@ def slow_client_checks(port):
     stop.set()
     for t in threads:
         t.join(60)
-    assert not cut_early, ("trickling clients were cut off while sending often enough", cut_early)
+    assert not cut_early, ("trickling clients were cut off before the deadline", cut_early)
     # A client slower than the read timeout (a byte every 3 s) is cut off.
     with socket.create_connection(("127.0.0.1", port), timeout=60) as c:
         c.sendall(b"GET /api/frame HTTP/1.1\r\n")
@@ -450,6 +473,354 @@ def concurrency_checks(port):
         c.close()
     check_good(port)
     return len(results) + len(idle) + len(many)
+
+
+# ---- floods, slow-loris, idle and bursts of connections, the port
+
+def server_pid(port):
+    """The pid of the process listening on 127.0.0.1:port (its socket's
+    inode in /proc/net/tcp, found among /proc/PID/fd)."""
+    inode = None
+    for line in open("/proc/net/tcp").read().splitlines()[1:]:
+        f = line.split()
+        if f[3] == "0A" and f[1] == "0100007F:%04X" % port:
+            inode = f[9]
+    assert inode, "no listening socket on port %d" % port
+    target = "socket:[%s]" % inode
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            for fd in os.listdir("/proc/%s/fd" % pid):
+                if os.readlink("/proc/%s/fd/%s" % (pid, fd)) == target:
+                    return int(pid)
+        except OSError:
+            continue
+    raise AssertionError("no process holds the socket of port %d" % port)
+
+
+def rss_kib(pid):
+    for line in open("/proc/%d/status" % pid):
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1])
+    raise AssertionError("no VmRSS for %d" % pid)
+
+
+def cpu_seconds(pid):
+    f = open("/proc/%d/stat" % pid).read().rsplit(")", 1)[1].split()
+    return (int(f[11]) + int(f[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def tcp_state(sock):
+    """The state of our end of `sock` in /proc/net/tcp ("01" established,
+    "08" close-wait: the server closed it), None when it is gone."""
+    local = "0100007F:%04X" % sock.getsockname()[1]
+    for line in open("/proc/net/tcp").read().splitlines()[1:]:
+        f = line.split()
+        if f[1] == local:
+            return f[3]
+    return None
+
+
+def readable_now(socks):
+    """Those of `socks` with something to read (or closed), without waiting."""
+    poller = select.poll()
+    for c in socks:
+        poller.register(c, select.POLLIN)
+    ready = {fd for fd, _ in poller.poll(0)}
+    return [c for c in socks if c.fileno() in ready]
+
+
+def raise_fd_limit(want):
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    if soft != resource.RLIM_INFINITY and soft < want:
+        resource.setrlimit(resource.RLIMIT_NOFILE, (want if hard == resource.RLIM_INFINITY else min(want, hard), hard))
+
+
+def page_load(port):
+    """What a browser fetches for the page; the seconds it took."""
+    start = time.monotonic()
+    for path in ("/", "/step.css", "/step.js", "/favicon.ico", "/api/frame", "/api/stages", "/api/stage?name=final"):
+        status, headers, body = request(port, path)
+        assert status == 200 and len(body) > 0, (path, status)
+    return time.monotonic() - start
+
+
+def range_checks(port):
+    """Range is refused (416, a short JSON error) on every endpoint: never a
+    partial body, never the answer once per range."""
+    n = 0
+    flood = "bytes=" + ",".join(["0-"] * 2700)
+    for path in ("/api/tile?x=0&y=0", "/", "/step.js", "/api/stage?name=final"):
+        data = request_bytes(port, path, headers={"Range": flood})
+        assert len(data) > 8000
+        with socket.create_connection(("127.0.0.1", port), timeout=60) as c:
+            c.sendall(data)
+            reply = wait_closed(c, 60)
+        assert len(reply) < 4096, (path, len(reply))
+        check_error(("Range flood", path), parse_answers(reply)[0], (416,))
+        n += 1
+    for path in ("/api/frame", "/api/tile?x=0&y=0", "/api/pixel?x=1&y=1", "/", "/step.js", "/api/stage?name=final"):
+        for rng in ("bytes=0-10", "bytes=5-", "bytes=-3", "bytes=0-0,2-2", "items=0-1"):
+            answer = request(port, path, headers={"Range": rng})
+            check_error(("Range", path, rng), answer, (416,))
+            assert "content-range" not in answer[1]
+            n += 1
+    return n
+
+
+def flood_checks(port):
+    """Head limits: 100 header lines and 16 KiB pass, one more is 431; a
+    flood of 100,000 header lines (50 MB) is refused with 431 after 16 KiB
+    (answered long before it is all sent), 24 times, and the server's
+    resident memory grows by less than 8 MB."""
+    pid = server_pid(port)
+
+    def head_with(lines):
+        return request_bytes(port, "/api/frame", headers=dict(("X-%03d" % i, "v") for i in range(lines)))
+
+    assert exchange(port, head_with(MAX_HEADER_LINES - 2))[0][0] == 200  # with Host and Connection: 100
+    check_error("101 header lines", exchange(port, head_with(MAX_HEADER_LINES - 1))[0], (431,))
+    base = request_bytes(port, "/api/frame", headers={"X-Pad": "", "X-Pad2": ""})
+    pad = MAX_HEAD_BYTES - len(base)
+    exact = request_bytes(port, "/api/frame", headers={"X-Pad": "p" * (pad // 2), "X-Pad2": "p" * (pad - pad // 2)})
+    assert len(exact) == MAX_HEAD_BYTES
+    assert exchange(port, exact)[0][0] == 200
+    over = exact.replace(b"X-Pad: ", b"X-Pad: p", 1)
+    check_error("a head of 16385 bytes", exchange(port, over)[0], (431,))
+
+    def header_flood():
+        line = b"X-Flood: " + b"v" * 489 + b"\r\n"  # 500 bytes: 100,000 lines are 50 MB
+        chunk = line * 128
+        sent = 0
+        with socket.create_connection(("127.0.0.1", port), timeout=60) as c:
+            c.sendall(b"GET /api/frame HTTP/1.1\r\nHost: 127.0.0.1\r\n")
+            reply = b""
+            while sent < 100000 * len(line):
+                c.sendall(chunk)
+                sent += len(chunk)
+                if readable_now([c]):
+                    break
+            reply = wait_closed(c, 60)
+        assert sent < 4 << 20, ("no answer after %d bytes" % sent)
+        check_error("100,000 header lines", parse_answers(reply)[0], (431,))
+
+    header_flood()
+    before = rss_kib(pid)
+    for _ in range(24):
+        header_flood()
+    check_good(port)
+    after = rss_kib(pid)
+    assert after - before < 8 * 1024, ("VmRSS grew by %d KiB" % (after - before))
+    print("hostile: 25 floods of 100,000 header lines: 431 each, VmRSS %d -> %d KiB" % (before, after), flush=True)
+    return 6 + 25
+
+
+class SlowLoris:
+    """`count` connections, each sending a header byte a second from one
+    thread; records when the server closes each."""
+
+    def __init__(self, port, count):
+        self.socks = [socket.create_connection(("127.0.0.1", port), timeout=60) for _ in range(count)]
+        self.started = time.monotonic()
+        self.closed = {}  # index -> seconds after the first byte
+        self.stop = threading.Event()
+        for c in self.socks:
+            c.sendall(b"GET /api/frame HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ")
+        self.thread = threading.Thread(target=self.run)
+        self.thread.start()
+
+    def mark(self, i):
+        if i not in self.closed:
+            self.closed[i] = time.monotonic() - self.started
+
+    def run(self):
+        while not self.stop.is_set() and len(self.closed) < len(self.socks):
+            for i, c in enumerate(self.socks):
+                if i in self.closed:
+                    continue
+                try:
+                    c.sendall(b"z")
+                except OSError:
+                    self.mark(i)
+            poller = select.poll()  # not select(): descriptors may be past 1024
+            index = {}
+            for i, c in enumerate(self.socks):
+                if i not in self.closed:
+                    poller.register(c, select.POLLIN)
+                    index[c.fileno()] = i
+            for fd, _ in poller.poll(1000):
+                i = index[fd]
+                c = self.socks[i]
+                try:
+                    if c.recv(4096) == b"":
+                        self.mark(i)
+                except OSError:
+                    self.mark(i)
+
+    def open_count(self):
+        return len(self.socks) - len(self.closed)
+
+    def finish(self, limit):
+        self.thread.join(limit)
+        self.stop.set()
+        self.thread.join(10)
+        for c in self.socks:
+            c.close()
+
+
+def slow_loris_checks(port):
+    """64 connections sending a header byte a second: a page load is
+    answered (within 3 s; about 0.1 s unloaded) while all of them are
+    open, and the server cuts each at the head's deadline (5 s)."""
+    loris = SlowLoris(port, 64)
+    took = page_load(port)
+    still_open = loris.open_count()
+    assert took < 3, "a page load took %.1f s while 64 slow-loris connections were open" % took
+    assert still_open == 64, ("slow-loris connections closed before the page was served", loris.closed)
+    loris.finish(30)
+    assert len(loris.closed) == 64, "slow-loris connections still open 30 s after their first byte"
+    latest = max(loris.closed.values())
+    assert min(loris.closed.values()) >= REQUEST_DEADLINE - 0.5, loris.closed
+    print("hostile: slow-loris: page load %.2f s with 64 open; all cut %.1f-%.1f s after their first byte"
+          % (took, min(loris.closed.values()), latest), flush=True)
+    return 64
+
+
+def idle_checks(port):
+    """1,000 idle connections (nothing sent) and 64 slow-loris ones: a page
+    load is answered (within 3 s) while the slow-loris ones are open and the
+    idle ones have all connected; over the connection cap (1,024) the oldest
+    idle ones are closed to let new ones in."""
+    raise_fd_limit(4096)
+    pid = server_pid(port)
+    before = rss_kib(pid)
+    idle = [socket.create_connection(("127.0.0.1", port), timeout=60) for _ in range(1000)]
+    loris = SlowLoris(port, 64)
+    took = page_load(port)
+    still_open = loris.open_count()
+    readable = readable_now(idle)
+    during = rss_kib(pid)
+    assert during - before < 16 * 1024, ("VmRSS grew by %d KiB with 1,064 connections" % (during - before))
+    assert took < 3, "a page load took %.1f s with 1,000 idle and 64 slow-loris connections" % took
+    assert still_open == 64, loris.closed
+    loris.finish(30)
+    for c in idle:
+        c.close()
+    check_good(port)
+    print("hostile: 1,000 idle + 64 slow-loris connections: page load %.2f s (%d idle ones closed by then), "
+          "VmRSS %d -> %d KiB" % (took, len(readable), before, during), flush=True)
+    return 1064
+
+
+def burst_checks(port):
+    """200 connections opened at once, then a request on each: every one
+    answered (the listen backlog holds them: no SYN retries)."""
+    start = time.monotonic()
+    conns = [socket.create_connection(("127.0.0.1", port), timeout=60) for _ in range(200)]
+    connected = time.monotonic() - start
+    for c in conns:
+        c.sendall(request_bytes(port, "/api/frame"))
+    for c in conns:
+        answers = parse_answers(wait_closed(c, 60))
+        assert answers and answers[0][0] == 200, answers[:1]
+        c.close()
+    took = time.monotonic() - start
+    assert connected < 1.0, "200 connects took %.1f s (SYN retries: the listen backlog is short)" % connected
+    print("hostile: burst: 200 connections in %.2f s, all answered in %.2f s" % (connected, took), flush=True)
+    return 200
+
+
+def slow_reader_checks(port):
+    """8 clients (twice the workers) that pipeline 19 requests for a 0.7 MB
+    answer each and read nothing: once the server has made the first answer
+    of each (and gone quiet), the answers wait for their readers in the
+    server, never in a worker, so a page load is answered (within 3 s) while
+    all 8 are connected; they are closed after 5 s without reading."""
+    pid = server_pid(port)
+    before = rss_kib(pid)
+    one = ("GET /api/tile?x=2&y=1 HTTP/1.1\r\nHost: 127.0.0.1:%d\r\n\r\n" % port).encode()
+    conns = []
+    for _ in range(8):
+        c = socket.create_connection(("127.0.0.1", port), timeout=60)
+        c.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        c.sendall(one * (KEEP_ALIVE_REQUESTS - 1))
+        conns.append(c)
+    # Quiet: no CPU spent for 0.3 s (a sanitizer build takes longer to get there).
+    last, deadline = cpu_seconds(pid), time.monotonic() + 30
+    while time.monotonic() < deadline:
+        time.sleep(0.3)
+        now = cpu_seconds(pid)
+        if now - last < 0.02:
+            break
+        last = now
+    took = page_load(port)
+    states = [tcp_state(c) for c in conns]
+    during = rss_kib(pid)
+    assert took < 3, "a page load took %.1f s while 8 clients did not read their answers" % took
+    assert states == ["01"] * 8, ("clients that did not read were closed before the page load ended", states)
+    # Bounded while they wait (16 MiB of waiting answers, and what the
+    # workers used to make them), and given back once they are gone.
+    assert during - before < 256 * 1024, ("VmRSS grew by %d KiB" % (during - before))
+    # Closed by the server: our end leaves ESTABLISHED (01) without our
+    # reading a byte (reading would count as progress).
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and any(tcp_state(c) == "01" for c in conns):
+        time.sleep(0.5)
+    states = [tcp_state(c) for c in conns]
+    for c in conns:
+        c.close()
+    assert "01" not in states, ("clients that read nothing were still connected after 60 s", states)
+    check_good(port)
+    time.sleep(0.5)  # the server gives memory back when idle
+    after = rss_kib(pid)
+    assert after - before < 8 * 1024, ("VmRSS %d KiB before, %d after" % (before, after))
+    print("hostile: 8 clients not reading 19 answers each: page load %.2f s, VmRSS %d -> %d -> %d KiB"
+          % (took, before, during, after), flush=True)
+    return 8 * 19
+
+
+def fd_shortage_checks(port):
+    """The server's descriptor limit lowered below its connection cap
+    (prlimit): 300 connections at once make accept() fail with EMFILE; the
+    server closes its oldest idle connections to go on, answers a request,
+    and does not spin (CPU time over 2 s with the connections open)."""
+    pid = server_pid(port)
+    old = resource.prlimit(pid, resource.RLIMIT_NOFILE)
+    in_use = len(os.listdir("/proc/%d/fd" % pid))
+    resource.prlimit(pid, resource.RLIMIT_NOFILE, (in_use + 20, old[1]))
+    try:
+        conns = [socket.create_connection(("127.0.0.1", port), timeout=60) for _ in range(300)]
+        check_good(port)
+        cpu = cpu_seconds(pid)
+        time.sleep(2)
+        spent = cpu_seconds(pid) - cpu
+        check_good(port)
+        for c in conns:
+            c.close()
+    finally:
+        resource.prlimit(pid, resource.RLIMIT_NOFILE, old)
+    assert spent < 0.5, "the server used %.2f s of CPU in 2 s while out of descriptors" % spent
+    check_good(port)
+    print("hostile: out of descriptors (limit %d): answered, %.2f s of CPU in 2 s" % (in_use + 20, spent), flush=True)
+    return 300
+
+
+def port_clash_checks(port):
+    """A second `step --serve` on the same port fails with one line naming
+    the port (exit 1); the first goes on answering every request."""
+    pid = server_pid(port)
+    exe = os.readlink("/proc/%d/exe" % pid)
+    args = open("/proc/%d/cmdline" % pid, "rb").read().split(b"\0")[:-1]
+    args = [a.decode() for a in args]
+    i = args.index("--port")
+    args[i + 1] = str(port)
+    r = subprocess.run([exe] + args[1:], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 1 and "serving" not in r.stdout, (r.returncode, r.stdout, r.stderr)
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "127.0.0.1:%d" % port in lines[0], r.stderr
+    for _ in range(20):
+        check_good(port)
+    print("hostile: a second server on port %d: %s" % (port, lines[0]), flush=True)
+    return 21
 
 
 # ---- the fuzz loop
@@ -611,6 +982,9 @@ def run(port, frame):
               ("page files and traversal", traversal_checks), ("numbers", lambda p: number_checks(p, frame)),
               ("malformed requests", malformed_checks), ("keep-alive limit", keep_alive_checks),
               ("slow and idle clients", slow_client_checks), ("concurrent clients", concurrency_checks),
+              ("Range", range_checks), ("head floods", flood_checks), ("slow-loris", slow_loris_checks),
+              ("idle connections", idle_checks), ("connection burst", burst_checks), ("clients that do not read", slow_reader_checks),
+              ("out of descriptors", fd_shortage_checks), ("port clash", port_clash_checks),
               ("fuzz", fuzz_checks)]
     for name, check in groups:
         start = time.monotonic()

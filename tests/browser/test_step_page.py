@@ -7,6 +7,14 @@ breakdown the page shows is, character for character, what the terminal
 front end (`step` with `pixel X Y` on standard input) prints for the same
 pixel; then a triangle from the pixel's history, the slider, and bad
 requests (4xx JSON, the server still answering afterwards).
+The view, at windows of 1280x800, 1600x1000 and 3840x2160 (for a 320x180 and
+a 1280x720 frame): the whole frame fitted with its aspect, no sideways
+scroll, the panels reachable with the image still in view; a click after a
+4x and a 16x wheel zoom selects the pixel computed from the image's rect;
+the value under the pointer; the keyboard; the "tri N" link brings its
+panel into view; the depth stage's legend; the slider's note; the message
+once the server is stopped. And the `--out DIR` page: every image has its
+PNG's aspect, the depth figure its legend. Screenshots: /tmp/h3-*.png.
 
 usage: test_step_page.py STEP_EXE [--api]
 With --api, no browser: the JSON API only (every endpoint, the pixel text
@@ -123,6 +131,16 @@ def api_checks(step):
         assert code == 200 and frame["width"] == 320 and frame["height"] == 180, frame
         code, stages = get(base + "/api/stages")
         assert code == 200 and "final" in [s["name"] for s in stages]
+        # Each stage's scale (stepper/stages.cpp stage_scale): well formed.
+        for st in stages:
+            sc = st.get("scale")
+            assert sc and sc["kind"] in ("ramp", "classes", "channels", "picture"), st
+            colours = [c for _, c in sc["stops"]] + [c for c, _ in sc["classes"]]
+            assert all(len(c) == 7 and c[0] == "#" and int(c[1:], 16) >= 0 for c in colours), st
+            if sc["kind"] == "ramp":
+                ts = [t for t, _ in sc["stops"]]
+                assert ts[0] == 0 and ts[-1] == 1 and ts == sorted(ts) and sc["ticks"], st
+            assert (sc["kind"] == "picture") == (st["name"] == "final"), st
         for x, y in ((100, 150), (0, 0), (319, 179), (160, 90)):
             code, p = get(base + "/api/pixel?x=%d&y=%d" % (x, y))
             assert code == 200 and p["text"] == step_text(step, "pixel %d %d\n" % (x, y)), (x, y)
@@ -163,6 +181,382 @@ def api_checks(step):
         stop_server(server)
 
 
+WINDOWS = ((1280, 800), (1600, 1000), (3840, 2160))
+
+
+def rect(driver, element):
+    return driver.execute_script("const r = arguments[0].getBoundingClientRect();"
+                                 "return [r.left, r.top, r.right, r.bottom];", element)
+
+
+def set_viewport(driver, w, h):
+    """Makes the page's viewport w x h CSS px at 1 device pixel per CSS px (the
+    DevTools protocol's override: a headless window is bounded by its screen)."""
+    driver.execute_cdp_cmd("Emulation.setDeviceMetricsOverride",
+                           {"width": w, "height": h, "deviceScaleFactor": 1, "mobile": False})
+    inner = driver.execute_script("return [window.innerWidth, window.innerHeight, window.devicePixelRatio]")
+    assert inner == [w, h, 1], ("viewport", inner, (w, h))
+
+
+def wait_image(driver, wait, width, src=None):
+    img = driver.find_element("id", "image")
+    if src:
+        wait.until(lambda d: src in img.get_attribute("src"))
+    wait.until(lambda d: d.execute_script("return arguments[0].complete && arguments[0].naturalWidth", img) == width)
+    return img
+
+
+def check_fit(driver, wait, frame_w, frame_h, label):
+    """The whole frame in the view with its aspect, filling it one way; no
+    scrolling of the page; every panel reachable with the image still in view."""
+    img = wait_image(driver, wait, frame_w)
+    view = driver.find_element("id", "view")
+    border = 1
+
+    def inside(_):
+        i, v = rect(driver, img), rect(driver, view)
+        return i[0] >= v[0] + border - 0.01 and i[1] >= v[1] + border - 0.01 and i[2] <= v[2] - border + 0.01 \
+            and i[3] <= v[3] - border + 0.01
+    # The page refits when the view's size changes (a ResizeObserver, before the next frame).
+    wait.until(lambda d: d.execute_script("return document.getElementById('zoom-value').textContent")
+               .endswith("(fit)"))
+    try:
+        wait.until(inside)
+    except Exception:
+        pass  # the assertion below says what is wrong
+    il, it, ir, ib = rect(driver, img)
+    vl, vt, vr, vb = rect(driver, view)
+    assert il >= vl + border - 0.01 and it >= vt + border - 0.01 and ir <= vr - border + 0.01 \
+        and ib <= vb - border + 0.01, (label, "image", (il, it, ir, ib), "view", (vl, vt, vr, vb))
+    aspect = (ir - il) / (ib - it)
+    assert abs(aspect / (frame_w / frame_h) - 1) < 0.01, (label, aspect)
+    # Fitted: as wide or as high as the view (within a pixel).
+    inner_w, inner_h = vr - vl - 2 * border, vb - vt - 2 * border
+    assert abs((ir - il) - inner_w) < 1 or abs((ib - it) - inner_h) < 1, (label, "not fitted")
+    inner = driver.execute_script("return [window.innerWidth, window.innerHeight]")
+    assert vl >= 0 and vt >= 0 and vr <= inner[0] and vb <= inner[1], (label, "view outside the window")
+    sw, cw, sh, ch = driver.execute_script("const e = document.documentElement;"
+                                           "return [e.scrollWidth, e.clientWidth, e.scrollHeight, e.clientHeight]")
+    assert sw <= cw and sh <= ch, (label, "the page scrolls", sw, cw, sh, ch)
+    for panel in ("pixel-panel", "tri-panel", "tile-panel"):
+        el = driver.find_element("id", panel)
+        driver.execute_script("arguments[0].open = true; arguments[0].scrollIntoView({block: 'start'})", el)
+        top = rect(driver, el.find_element("tag name", "summary"))
+        assert top[1] >= 0 and top[3] <= inner[1] and top[2] <= inner[0], (label, panel, top)
+        assert rect(driver, view) == [vl, vt, vr, vb], (label, panel, "scrolled the image away")
+        assert driver.execute_script("return [window.scrollX, window.scrollY]") == [0, 0], (label, panel)
+    driver.execute_script("document.getElementById('right').scrollTop = 0")
+    return (il, it, ir, ib)
+
+
+def pointer(driver, x, y, click=False):
+    """Moves the mouse to window position (x, y), and clicks there."""
+    from selenium.webdriver.common.actions.action_builder import ActionBuilder
+    ab = ActionBuilder(driver)
+    ab.pointer_action.move_to_location(int(x), int(y))
+    if click:
+        ab.pointer_action.click()
+    ab.perform()
+
+
+def wheel(driver, x, y, delta_y):
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
+    ActionChains(driver).scroll_from_origin(ScrollOrigin.from_viewport(int(x), int(y)), 0, int(delta_y)).perform()
+
+
+def screen_point(img_rect, frame_w, frame_h, px, py):
+    """An integer window position inside image pixel (px, py), away from
+    its edges (the middle half of the pixel when it is 2 px wide or more),
+    and the pixel the image's rect puts under it."""
+    il, it, ir, ib = img_rect
+    sx, sy = (ir - il) / frame_w, (ib - it) / frame_h
+    best = None
+    for X in range(int(il + px * sx) - 1, int(il + (px + 1) * sx) + 2):
+        for Y in range(int(it + py * sy) - 1, int(it + (py + 1) * sy) + 2):
+            fx, fy = (X - il) / sx, (Y - it) / sy
+            if (int(fx), int(fy)) != (px, py):
+                continue
+            margin = min(fx - int(fx), 1 - (fx - int(fx)), fy - int(fy), 1 - (fy - int(fy)))
+            if best is None or margin > best[0]:
+                best = (margin, X, Y, int(fx), int(fy))
+    margin, X, Y, ex, ey = best
+    assert margin >= 0.2, ("no position well inside the pixel", best)
+    return X, Y, ex, ey
+
+
+def click_pixel_at_zoom(driver, wait, step, frame, zoom_notches, target):
+    """Zooms by 2^(notches/2) around the target pixel with the wheel (4 notches
+    at a time: one wheel event of -400 px), then
+    clicks inside the target pixel and checks that the page explains the
+    pixel computed from the image's rect, with step's exact text."""
+    img = driver.find_element("id", "image")
+    before = rect(driver, img)
+    X, Y, _, _ = screen_point(before, frame["width"], frame["height"], *target)
+    for _ in range(zoom_notches // 4):
+        wheel(driver, X, Y, -400)
+    after = rect(driver, img)
+    factor = (after[2] - after[0]) / (before[2] - before[0])
+    assert abs(factor - 2 ** (zoom_notches / 2)) < 1e-3 * factor, ("zoom", factor)
+    # The point under the pointer stayed on the same image point.
+    for a, b, c, d, p in ((before[0], before[2], after[0], after[2], X), (before[1], before[3], after[1], after[3], Y)):
+        assert abs((p - a) / (b - a) - (p - c) / (d - c)) < 2e-3, ("zoom moved the point under the pointer",)
+    X, Y, ex, ey = screen_point(after, frame["width"], frame["height"], *target)
+    pointer(driver, X, Y)
+    wait.until(lambda d: d.find_element("id", "cursor-value").text.startswith("x %d y %d " % (ex, ey)))
+    pointer(driver, X, Y, click=True)
+    wait.until(lambda d: d.find_element("id", "pixel-coords").text == "%d %d" % (ex, ey))
+    wait.until(lambda d: d.find_element("id", "pixel-text").get_attribute("textContent").startswith(
+        "pixel %d %d:" % (ex, ey)))
+    shown = driver.find_element("id", "pixel-text").get_attribute("textContent")
+    expected = step_text(step, "pixel %d %d\n" % (ex, ey))
+    assert shown == expected, "the page's breakdown differs from step's:\n" + shown + "\n---\n" + expected
+    return ex, ey, expected, factor
+
+
+def open_browser(browser, driver_path, profile, size):
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+    options = webdriver.ChromeOptions()
+    options.binary_location = browser
+    for flag in ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                 "--hide-scrollbars", "--force-device-scale-factor=1",
+                 "--window-size=%d,%d" % size, "--user-data-dir=" + profile):
+        options.add_argument(flag)
+    return webdriver.Chrome(service=Service(driver_path), options=options)
+
+
+def page_checks(driver, step, server, url):
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import Select, WebDriverWait
+    wait = WebDriverWait(driver, 60)
+    set_viewport(driver, 1600, 1000)
+    driver.get(url)
+    wait.until(lambda d: "triangles" in d.find_element(By.ID, "summary").text)
+    frame = get(url.rstrip("/") + "/api/frame")[1]
+    W, H = frame["width"], frame["height"]
+    img = wait_image(driver, wait, W)
+
+    # Fitted at each window size; the page never scrolls.
+    for w, h in WINDOWS:
+        set_viewport(driver, w, h)
+        r = check_fit(driver, wait, W, H, "%dx%d" % (w, h))
+        driver.save_screenshot("/tmp/h3-%dx%d.png" % (w, h))
+        print("%dx%d: the %dx%d frame fitted at %.3fx, aspect kept, no page scroll, panels reachable"
+              % (w, h, W, H, (r[2] - r[0]) / W))
+    set_viewport(driver, 1600, 1000)
+    check_fit(driver, wait, W, H, "1600x1000 again")
+
+    # Clicks: at fit, then after a 4x and a 16x wheel zoom around the pixel
+    # (the pixel grid shows from 8 device pixels per image pixel).
+    zoom = 1
+    for notches, target in ((0, (100, 150)), (4, (100, 150)), (4, (101, 151))):
+        x, y, expected, factor = click_pixel_at_zoom(driver, wait, step, frame, notches, target)
+        assert (x, y) == target, ((x, y), target)
+        zoom *= factor
+        driver.save_screenshot("/tmp/h3-zoom%d.png" % round(zoom))
+        print("zoom %g x fit: the click inside pixel %d %d explains that pixel (step's text exactly)" % (zoom, x, y))
+    assert "srgb8 " in expected and "shading of #" in expected
+    rows = driver.find_elements(By.CSS_SELECTOR, "#history tbody tr")
+    assert len(rows) >= 1
+    # The value under the pointer: the final image's colour is the pixel's srgb8.
+    srgb8 = [l for l in expected.splitlines() if l.startswith("srgb8 ")][0].split()[1:]
+    value = driver.find_element(By.ID, "cursor-value").text
+    assert "displayed colour (%s)" % ", ".join(srgb8) in value, (value, srgb8)
+    print("value under the pointer: %s" % value)
+    # The samples table: one row per sample, holding what the text says.
+    sample_rows = driver.find_elements(By.CSS_SELECTOR, "#samples tbody tr")
+    assert len(sample_rows) == frame["samples"], len(sample_rows)
+    shown_held = {k: r.find_elements(By.TAG_NAME, "td")[2].text for k, r in enumerate(sample_rows)}
+    assert shown_held == samples_in_text(expected), (shown_held, samples_in_text(expected))
+    if frame["samples"] > 1:
+        covers = [l.split("covers samples ")[1].split(" of")[0] for l in expected.splitlines()
+                  if l.startswith("     covers samples ")]
+        assert [r.find_elements(By.TAG_NAME, "td")[3].text for r in rows] == covers
+
+    # Keyboard: the arrows move the selected pixel, Enter explains it; F fits.
+    view = driver.find_element(By.ID, "view")
+    view.send_keys(Keys.ARROW_RIGHT, Keys.ARROW_RIGHT, Keys.ARROW_UP, Keys.ENTER)
+    wait.until(lambda d: d.find_element(By.ID, "pixel-coords").text == "%d %d" % (x + 2, y - 1))
+    wait.until(lambda d: d.find_element(By.ID, "pixel-text").get_attribute("textContent")
+               == step_text(step, "pixel %d %d\n" % (x + 2, y - 1)))
+    view.send_keys("1")  # one image pixel per CSS px (the device scale factor is 1)
+    wait.until(lambda d: abs(rect(d, img)[2] - rect(d, img)[0] - W) < 0.01)
+    view.send_keys("f")
+    check_fit(driver, wait, W, H, "after F")
+    print("keyboard: arrows moved the selection to %d %d, Enter explained it, 1 showed 1:1, F fitted the frame"
+          % (x + 2, y - 1))
+
+    # The "tri N" link: its setup as `tri N` prints it, its panel brought into view.
+    set_viewport(driver, 1280, 800)
+    link = driver.find_element(By.CSS_SELECTOR, "#history a.tri")
+    tri = int(link.text.split()[1])
+    link.click()
+    wait.until(lambda d: d.find_element(By.ID, "tri-text").get_attribute("textContent").startswith("tri %d:" % tri))
+    assert driver.find_element(By.ID, "tri-text").get_attribute("textContent") == step_text(step, "tri %d\n" % tri)
+    summary = rect(driver, driver.find_element(By.CSS_SELECTOR, "#tri-panel > summary"))
+    right = rect(driver, driver.find_element(By.ID, "right"))
+    assert summary[1] >= right[1] - 0.5 and summary[3] <= min(right[3], 800), ("tri panel not in view", summary, right)
+    driver.save_screenshot("/tmp/h3-tri-link-1280x800.png")
+    print("tri %d: the page shows step's setup exactly, its panel scrolled into view" % tri)
+
+    # The clicked pixel's tile: its bins as `tile TX TY` prints them.
+    px, py = x + 2, y - 1
+    tx, ty = px // frame["tile_size"], py // frame["tile_size"]
+    wait.until(lambda d: d.find_element(By.ID, "tile-coords").text == "%d %d" % (tx, ty))
+    assert driver.find_element(By.ID, "tile-text").get_attribute("textContent") == \
+        step_text(step, "tile %d %d\n" % (tx, ty))
+    print("tile %d %d: the page shows step's bins exactly" % (tx, ty))
+
+    # The depth stage: its image, its sentence and its legend (near to far).
+    set_viewport(driver, 1600, 1000)
+    Select(driver.find_element(By.ID, "stage")).select_by_value("depth")
+    wait_image(driver, wait, W, "/api/stage?name=depth")
+    stages = {st["name"]: st for st in get(url.rstrip("/") + "/api/stages")[1]}
+    assert driver.find_element(By.ID, "stage-about").get_attribute("textContent") == stages["depth"]["about"]
+    assert "scale" in stages["depth"], "/api/stages gives no scale (stepper/http_server.cpp: stage_list_json)"
+    scale = stages["depth"]["scale"]
+    assert scale["kind"] == "ramp" and scale["units"] == "scene units" and scale["min"] < scale["max"], scale
+    legend = driver.find_element(By.ID, "legend-depth")
+    assert legend.is_displayed() and "(near)" in legend.text and "(far)" in legend.text, legend.text
+    assert "linear-gradient" in driver.find_element(By.CSS_SELECTOR, "#legend-depth .bar").value_of_css_property(
+        "background-image")
+    pointer(driver, *screen_point(rect(driver, img), W, H, 100, 150)[:2])
+    wait.until(lambda d: "scene units" in d.find_element(By.ID, "cursor-value").text)
+    driver.save_screenshot("/tmp/h3-depth.png")
+    print("stage: depth, its sentence, its legend (%s) and the depth under the pointer: %s"
+          % (legend.text.replace("\n", " / "), driver.find_element(By.ID, "cursor-value").text))
+
+    # Every legend tells the truth: each colour of a stage image is one of
+    # its classes, or on its colour bar (within 4 steps per channel).
+    checked = []
+    for name, st in stages.items():
+        if st["scale"]["kind"] not in ("classes", "ramp"):
+            continue
+        off = driver.execute_async_script("""
+            const [name, scale, done] = arguments, im = new Image();
+            im.onload = () => {
+              const c = document.createElement('canvas');
+              c.width = im.naturalWidth; c.height = im.naturalHeight;
+              const g = c.getContext('2d');
+              g.drawImage(im, 0, 0);
+              const d = g.getImageData(0, 0, c.width, c.height).data, seen = new Set(), off = [];
+              for (let i = 0; i < d.length; i += 4) seen.add((d[i] << 16) | (d[i + 1] << 8) | d[i + 2]);
+              for (const v of seen) {
+                const rgb = [v >> 16, (v >> 8) & 255, v & 255];
+                const known = scale.classes.some(([c]) => parseInt(c.slice(1), 16) === v);
+                if (!known && (scale.kind === 'classes' || readScale(scale, rgb) === 'not on the scale')) off.push(rgb);
+              }
+              done([seen.size, off.slice(0, 5)]);
+            };
+            im.onerror = () => done([0, ['cannot load']]);
+            im.src = '/api/stage?name=' + name;""", name, st["scale"])
+        assert off[0] >= 1 and not off[1], (name, "colours off its legend", off)
+        checked.append("%s (%d colours)" % (name, off[0]))
+    print("legends: every colour of " + ", ".join(checked) + " is on its legend")
+
+    # The slider: the frame after the first 1000 triangles; a click then
+    # says which frame the explanation is of.
+    driver.execute_script("const u = document.getElementById('upto'); u.value = 1000;"
+                          "u.dispatchEvent(new Event('input'));")
+    wait_image(driver, wait, W, "/api/upto?n=1000")
+    X, Y, ex, ey = screen_point(rect(driver, img), W, H, 60, 160)
+    pointer(driver, X, Y, click=True)
+    wait.until(lambda d: d.find_element(By.ID, "pixel-coords").text == "%d %d" % (ex, ey))
+    note = driver.find_element(By.ID, "pixel-note").text
+    assert "all %d triangles" % frame["triangles"] in note and "not at the slider's 1000" in note, note
+    print("slider: the frame after 1000 triangles; a click says: " + note)
+
+    # Bad requests: JSON errors, and the server goes on.
+    for path, status in (("/api/pixel?x=-1&y=0", 400), ("/api/pixel?x=320&y=0", 400), ("/api/tri?n=abc", 400),
+                         ("/api/tile?x=0", 400), ("/api/stage?name=nope", 404), ("/nope", 404),
+                         ("/api/pixel?x=" + "9" * 9000, 414)):
+        code, body = get(url.rstrip("/") + path)
+        assert code == status and "error" in body, (path, code, body)
+    code, body = get(url.rstrip("/") + "/api/frame")
+    assert code == 200 and body["width"] == 320
+    print("bad requests: 4xx JSON errors, server still answering")
+
+    # The server stops: the page says so, and keeps what it shows.
+    stop_server(server)
+    text_before = driver.find_element(By.ID, "pixel-text").get_attribute("textContent")
+    X, Y, _, _ = screen_point(rect(driver, img), W, H, 200, 100)
+    pointer(driver, X, Y, click=True)
+    wait.until(lambda d: "the step server stopped (or cannot be reached)" in d.find_element(By.ID, "status").text)
+    # Another stage cannot load: the last image stays, and so do the controls that describe it.
+    stage = Select(driver.find_element(By.ID, "stage"))
+    stage.select_by_value("normal")
+    wait.until(lambda d: stage.first_selected_option.get_attribute("value") == "depth")
+    assert "/api/upto?n=1000" in img.get_attribute("src")
+    assert driver.execute_script("return [arguments[0].naturalWidth, document.getElementById('upto').value]",
+                                 img) == [W, "1000"]
+    assert driver.find_element(By.ID, "pixel-text").get_attribute("textContent") == text_before
+    view.send_keys("+")
+    assert not driver.find_element(By.ID, "zoom-value").text.endswith("(fit)")
+    driver.save_screenshot("/tmp/h3-stopped.png")
+    print("stopped server: \"%s\"; the image and the texts stay, zoom still works"
+          % driver.find_element(By.ID, "status").text)
+
+
+def large_frame_checks(driver, step):
+    """A 1280x720 frame (step's default size) fitted at each window size."""
+    from selenium.webdriver.support.ui import WebDriverWait
+    server = subprocess.Popen([step, "--size", "1280x720", "--threads", "2", "--serve", "--port", "0"],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = server.stdout.readline()
+        assert "serving http://127.0.0.1:" in line, line + server.stderr.read()
+        url = line.split("serving ")[1].split(" ")[0]
+        wait = WebDriverWait(driver, 120)
+        driver.get(url)
+        wait.until(lambda d: "triangles" in d.find_element("id", "summary").text)
+        for w, h in WINDOWS:
+            set_viewport(driver, w, h)
+            r = check_fit(driver, wait, 1280, 720, "1280x720 frame at %dx%d" % (w, h))
+            driver.save_screenshot("/tmp/h3-1280x720-at-%dx%d.png" % (w, h))
+            print("%dx%d: the 1280x720 frame fitted at %.3fx" % (w, h, (r[2] - r[0]) / 1280))
+    finally:
+        stop_server(server)
+
+
+def export_checks(driver, step):
+    """The `--out DIR` page: each image with its PNG's aspect, legends."""
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+    out = tempfile.mkdtemp(prefix="prast_out_")
+    try:
+        r = subprocess.run([step] + FLAGS + ["--out", out], capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        stages = [n[:-4] for n in os.listdir(out) if n.endswith(".png")]
+        for w, h in ((1280, 800), (3840, 2160)):
+            set_viewport(driver, w, h)
+            driver.get("file://" + os.path.join(out, "index.html"))
+            WebDriverWait(driver, 60).until(lambda d: d.execute_script(
+                "return [...document.images].every((i) => i.complete && i.naturalWidth > 0)"))
+            images = driver.find_elements(By.CSS_SELECTOR, "figure img")
+            assert len(images) == len(stages) == 22, (len(images), len(stages))
+            for im in images:
+                nw, nh = driver.execute_script("return [arguments[0].naturalWidth, arguments[0].naturalHeight]", im)
+                l, t, rr, b = rect(driver, im)
+                assert (nw, nh) == (320, 180) and abs(((rr - l) / (b - t)) / (nw / nh) - 1) < 0.01, \
+                    (im.get_attribute("src"), (nw, nh), (l, t, rr, b))
+                assert rr <= w, ("image wider than the window", im.get_attribute("src"))
+            sw, cw = driver.execute_script("return [document.documentElement.scrollWidth,"
+                                           "document.documentElement.clientWidth]")
+            assert sw <= cw, ("--out page scrolls sideways", sw, cw)
+            depth = driver.find_element(By.CSS_SELECTOR, "figure#depth .legend")
+            assert "(near)" in depth.text and "(far)" in depth.text, depth.text
+            assert driver.find_elements(By.CSS_SELECTOR, "figure#overdraw .legend .classes i")
+            assert not driver.find_elements(By.CSS_SELECTOR, "figure#final .legend")
+            driver.execute_script("document.getElementById('depth').scrollIntoView()")
+            driver.save_screenshot("/tmp/h3-out-%dx%d.png" % (w, h))
+        print("--out: 22 images with their PNGs' aspect at 1280 and 3840 wide, no sideways scroll, legends")
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+
+
 def main():
     if len(sys.argv) not in (2, 3) or (len(sys.argv) == 3 and sys.argv[2] != "--api"):
         print(__doc__)
@@ -177,11 +571,7 @@ def main():
     if not browser or not driver_path:
         skip("chromium and chromium-driver are not installed (apt-get install chromium chromium-driver)")
     try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.service import Service
-        from selenium.webdriver.common.action_chains import ActionChains
-        from selenium.webdriver.common.by import By
-        from selenium.webdriver.support.ui import Select, WebDriverWait
+        import selenium  # noqa: F401
     except ImportError:
         skip("python3-selenium is not installed (apt-get install python3-selenium)")
 
@@ -190,94 +580,17 @@ def main():
     profile = tempfile.mkdtemp(prefix="prast_browser_")
     driver = None
     try:
-        options = webdriver.ChromeOptions()
-        options.binary_location = browser
-        for flag in ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                     "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                     "--window-size=1600,1000", "--user-data-dir=" + profile):
-            options.add_argument(flag)
-        driver = webdriver.Chrome(service=Service(driver_path), options=options)
-        driver.get(url)
-        wait = WebDriverWait(driver, 60)
-        wait.until(lambda d: "triangles" in d.find_element(By.ID, "summary").text)
-        img = driver.find_element(By.ID, "image")
-        wait.until(lambda d: d.execute_script("return arguments[0].complete && arguments[0].naturalWidth", img) == 320)
-
-        # Click a pixel of the floor (offsets from the element's centre).
-        width, height = img.size["width"], img.size["height"]
-        px, py = 100, 150
-        ActionChains(driver).move_to_element_with_offset(
-            img, int((px + 0.5) * width / 320 - width / 2), int((py + 0.5) * height / 180 - height / 2)).click().perform()
-        wait.until(lambda d: d.find_element(By.ID, "pixel-text").get_attribute("textContent").startswith("pixel "))
-        coords = driver.find_element(By.ID, "pixel-coords").text.split()
-        x, y = int(coords[0]), int(coords[1])
-        assert abs(x - px) <= 1 and abs(y - py) <= 1, (x, y)
-        shown = driver.find_element(By.ID, "pixel-text").get_attribute("textContent")
-        expected = step_text(step, "pixel %d %d\n" % (x, y))
-        assert shown == expected, "the page's breakdown differs from step's:\n" + shown + "\n---\n" + expected
-        assert "srgb8 " in shown and "shading of #" in shown
-        rows = driver.find_elements(By.CSS_SELECTOR, "#history tbody tr")
-        assert len(rows) >= 1
-        # The samples table: one row per sample, holding what the text says.
-        frame = get(url.rstrip("/") + "/api/frame")[1]
-        sample_rows = driver.find_elements(By.CSS_SELECTOR, "#samples tbody tr")
-        assert len(sample_rows) == frame["samples"], len(sample_rows)
-        shown_held = {k: r.find_elements(By.TAG_NAME, "td")[2].text for k, r in enumerate(sample_rows)}
-        assert shown_held == samples_in_text(expected), (shown_held, samples_in_text(expected))
-        # The history's sample columns: those of the text's "covers samples" lines.
-        if frame["samples"] > 1:
-            covers = [l.split("covers samples ")[1].split(" of")[0] for l in expected.splitlines()
-                      if l.startswith("     covers samples ")]
-            assert [r.find_elements(By.TAG_NAME, "td")[3].text for r in rows] == covers
-        print("pixel %d %d: the page shows step's breakdown exactly (%d lines, %d history rows, %d samples)"
-              % (x, y, shown.count("\n"), len(rows), len(sample_rows)))
-
-        # The triangle of the first fragment: its setup as `tri N` prints it.
-        link = driver.find_element(By.CSS_SELECTOR, "#history a.tri")
-        tri = int(link.text.split()[1])
-        link.click()
-        wait.until(lambda d: d.find_element(By.ID, "tri-text").get_attribute("textContent").startswith("tri %d:" % tri))
-        assert driver.find_element(By.ID, "tri-text").get_attribute("textContent") == step_text(step, "tri %d\n" % tri)
-        print("tri %d: the page shows step's setup exactly" % tri)
-
-        # The clicked pixel's tile: its bins as `tile TX TY` prints them.
-        tx, ty = x // frame["tile_size"], y // frame["tile_size"]
-        wait.until(lambda d: d.find_element(By.ID, "tile-coords").text == "%d %d" % (tx, ty))
-        wait.until(lambda d: d.find_element(By.ID, "tile-text").get_attribute("textContent").startswith("tile "))
-        assert driver.find_element(By.ID, "tile-text").get_attribute("textContent") == \
-            step_text(step, "tile %d %d\n" % (tx, ty))
-        print("tile %d %d: the page shows step's bins exactly" % (tx, ty))
-
-        # Switching stages: the depth stage's image and its sentence.
-        Select(driver.find_element(By.ID, "stage")).select_by_value("depth")
-        wait.until(lambda d: "/api/stage?name=depth" in img.get_attribute("src"))
-        wait.until(lambda d: d.execute_script("return arguments[0].complete && arguments[0].naturalWidth", img) == 320)
-        about = {st["name"]: st["about"] for st in get(url.rstrip("/") + "/api/stages")[1]}
-        assert driver.find_element(By.ID, "stage-about").get_attribute("textContent") == about["depth"]
-        print("stage: switched to depth, its image and sentence shown")
-
-        # The slider: the frame after the first 1000 triangles.
-        driver.execute_script("const u = document.getElementById('upto'); u.value = 1000;"
-                              "u.dispatchEvent(new Event('input'));")
-        wait.until(lambda d: "/api/upto?n=1000" in img.get_attribute("src"))
-        wait.until(lambda d: d.execute_script("return arguments[0].complete && arguments[0].naturalWidth", img) == 320)
-        print("slider: the frame after 1000 triangles loaded")
-
-        # Bad requests: JSON errors, and the server goes on.
-        for path, status in (("/api/pixel?x=-1&y=0", 400), ("/api/pixel?x=320&y=0", 400), ("/api/tri?n=abc", 400),
-                             ("/api/tile?x=0", 400), ("/api/stage?name=nope", 404), ("/nope", 404),
-                             ("/api/pixel?x=" + "9" * 9000, 414)):
-            code, body = get(url.rstrip("/") + path)
-            assert code == status and "error" in body, (path, code, body)
-        code, body = get(url.rstrip("/") + "/api/frame")
-        assert code == 200 and body["width"] == 320
-        print("bad requests: 4xx JSON errors, server still answering")
+        driver = open_browser(browser, driver_path, profile, (1600, 1000))
+        page_checks(driver, step, server, url)
+        export_checks(driver, step)
+        large_frame_checks(driver, step)
         print("1 passed, 0 failed")
         return 0
     finally:
         if driver is not None:
             driver.quit()
-        stop_server(server)
+        if server.poll() is None:
+            stop_server(server)
         shutil.rmtree(profile, ignore_errors=True)
 
 

@@ -4,6 +4,8 @@ frame
 pixel 780 380
 tri 43470
 tile 12 5
+draws
+draw 0
 pixel 640 560
 pixel 500 250
 pixel 900 200
