@@ -3,6 +3,7 @@
 // http_wire.h's. See http_server.h.
 #include "stepper/http_server.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdint>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include "stepper/explain.h"
 #include "stepper/http_connections.h"
 #include "stepper/stages.h"
+#include "stepper/views.h"
 #include "stepper/web_assets.h"
 
 namespace prast::stepper {
@@ -201,6 +203,65 @@ int serve(Session& session, int port) {
             const long x = int_param(req, "x", 0, rec.tiles_x - 1, "tile column", tiles_are);
             const long y = int_param(req, "y", 0, rec.tiles_y - 1, "tile row", tiles_are);
             return json_response(tile_json(s, rec, int(x), int(y)));
+        }
+        // The views (stepper/views.h), with the terminal's numbers. Every
+        // parameter is checked here, so an error never repeats the request.
+        const std::string draws_are = "the frame has " + std::to_string(rec.draws.size()) + " draws";
+        if (path == "/api/draws") {
+            DrawsView v;
+            if (!make_draws(s, rec, v).empty()) throw BadRequest{500, "the draws cannot be listed"};
+            return json_response(v.json());
+        }
+        if (path == "/api/draw") {
+            const long n = int_param(req, "n", 0, long(rec.draws.size()) - 1, "draw number", draws_are);
+            DrawView v;
+            if (!make_draw(s, rec, std::to_string(n), v).empty()) throw BadRequest{500, "the draw cannot be shown"};
+            return json_response(v.json());
+        }
+        if (path == "/api/textures") {
+            TexturesView v;
+            if (!make_textures(s, rec, v).empty()) throw BadRequest{500, "the textures cannot be listed"};
+            return json_response(v.json());
+        }
+        if (path == "/api/texture" || path == "/api/texture.png") {
+            // The ID among the frame's; the level among its levels.
+            TexturesView all;
+            if (!make_textures(s, rec, all).empty()) throw BadRequest{500, "the textures cannot be listed"};
+            if (req.param_count("id") != 1) throw BadRequest{400, "parameter 'id': one texture ID (see /api/textures)"};
+            const TextureInfo* info = nullptr;
+            for (const TextureInfo& t : all.textures)
+                if (t.id == req.param("id")) info = &t;
+            if (!info) throw BadRequest{404, "unknown texture ID (see /api/textures)"};
+            long level = 0;
+            if (req.param_count("level"))
+                level = int_param(req, "level", 0, info->levels - 1, "mip level",
+                                  "the texture has " + std::to_string(info->levels) + " levels");
+            const std::string id = info->id, lv = std::to_string(level);
+            if (path == "/api/texture") {
+                TextureView v;
+                if (!make_texture(s, rec, id, lv, v).empty()) throw BadRequest{500, "the texture cannot be shown"};
+                return json_response(v.json());
+            }
+            return png_response("texture " + id + " " + lv, [&] {
+                std::vector<std::uint8_t> png;
+                if (!texture_png(s, rec, id, lv, png).empty()) throw BadRequest{500, "the texture cannot be drawn"};
+                return png;
+            });
+        }
+        if (path == "/api/vertices") {
+            const long d = int_param(req, "draw", 0, long(rec.draws.size()) - 1, "draw number", draws_are);
+            const long count_all = long(rec.draws[std::size_t(d)].vertex_count);
+            const std::string has = "the draw has " + std::to_string(count_all) + " vertices";
+            long first = 0, count = kDefaultVertexRows;
+            if (req.param_count("first"))
+                first = int_param(req, "first", 0, std::max(0L, count_all - 1), "first vertex", has);
+            if (req.param_count("count"))
+                count = int_param(req, "count", 1, kMaxVertexRows, "vertex count",
+                                  "at most " + std::to_string(kMaxVertexRows) + " rows");
+            VerticesView v;
+            if (!make_vertices(s, rec, std::to_string(d), std::to_string(first), std::to_string(count), v).empty())
+                throw BadRequest{400, "the vertices cannot be shown (see /api/draws)"};
+            return json_response(v.json());
         }
         return error_response(404, "not found");
     };

@@ -152,17 +152,38 @@ def api_checks(step):
         assert code == 200 and t["text"] == step_text(step, "tile 2 1\n")
         with urllib.request.urlopen(base + "/api/stage?name=final", timeout=60) as r:
             assert r.headers["Content-Type"] == "image/png" and r.read(8) == b"\x89PNG\r\n\x1a\n"
+        # The views (stepper/views.h): the JSON of each holds the terminal's text.
+        for path, command in (("/api/draws", "draws"), ("/api/draw?n=24", "draw 24"), ("/api/textures", "textures"),
+                              ("/api/vertices?draw=3&first=5&count=7", "vertices 3 5 7")):
+            code, v = get(base + path)
+            assert code == 200, (path, v)
+            if "text" in v:
+                assert v["text"] == step_text(step, command + "\n"), path
+        code, v = get(base + "/api/draws")
+        assert len(v["draws"]) == 25 and v["draws"][24]["mesh_name"] == "floor", v["draws"][24]
+        code, v = get(base + "/api/texture?id=env&level=2")
+        assert code == 200 and v["id"] == "env" and v["level"] == 2, v
+        with tempfile.TemporaryDirectory() as tmp:
+            written = os.path.join(tmp, "env2.png")
+            step_text(step, "texture env 2 %s\n" % written)
+            with open(written, "rb") as f, urllib.request.urlopen(base + "/api/texture.png?id=env&level=2",
+                                                                 timeout=60) as r:
+                assert r.headers["Content-Type"] == "image/png" and r.read() == f.read()
         # Malformed requests, a fixed list and a bounded, seeded random loop.
         bad = [("/api/pixel?x=-1&y=0", 400), ("/api/pixel?x=320&y=0", 400), ("/api/pixel?x=1", 400),
                ("/api/pixel?x=1e2&y=0", 400), ("/api/pixel?x=0x10&y=0", 400), ("/api/tri?n=abc", 400),
                ("/api/tri?n=98432", 400), ("/api/tri?n=" + "9" * 40, 400), ("/api/tile?x=0", 400),
                ("/api/tile?x=5&y=0", 400), ("/api/upto?n=-1", 400), ("/api/upto", 400),
                ("/api/stage?name=nope", 404), ("/api/stage", 404), ("/nope", 404), ("/../../etc/passwd", 404),
-               ("/api/pixel?x=" + "9" * 9000, 414)]
+               ("/api/pixel?x=" + "9" * 9000, 414), ("/api/draw?n=25", 400), ("/api/draw", 400),
+               ("/api/texture?id=nope", 404), ("/api/texture", 400), ("/api/texture?id=0&level=99", 400),
+               ("/api/texture.png?id=env&level=-1", 400), ("/api/vertices?draw=0&count=1001", 400),
+               ("/api/vertices?draw=0&first=999999", 400), ("/api/vertices", 400)]
         rng = random.Random(10)
         alphabet = "0123456789-+.e%&=?/xyn abc\u00e9"
         for _ in range(150):
-            endpoint = rng.choice(["/api/pixel", "/api/tri", "/api/tile", "/api/upto", "/api/stage"])
+            endpoint = rng.choice(["/api/pixel", "/api/tri", "/api/tile", "/api/upto", "/api/stage", "/api/draw",
+                                   "/api/texture", "/api/texture.png", "/api/vertices"])
             query = "".join(rng.choice(alphabet) for _ in range(rng.randint(0, 30)))
             bad.append((endpoint + "?" + urllib.parse.quote(query, safe="&=%"), None))
         for path, status in bad:
