@@ -297,8 +297,16 @@ std::string frame_text(const FrameSetup& s, const Recording& rec) {
       << num(c.near_plane) << " far " << (c.infinite_far ? std::string("infinite") : num(c.far_plane)) << "\n";
     for (std::size_t i = 0; i < s.settings.lights.size(); ++i) {
         const ShadingLight& L = s.settings.lights[i];
-        o << "light " << i << ": " << (L.point ? "point at " + vec(L.position) : "sun towards " + vec(L.direction))
-          << " radiance " << vec(L.radiance) << "\n";
+        o << "light " << i << ": "
+          << (L.spot    ? "spot at " + vec(L.position) + " shining along " + vec(glm::vec3(0.0f) - L.direction)
+              : L.point ? "point at " + vec(L.position)
+                        : "sun towards " + vec(L.direction))
+          << " radiance " << vec(L.radiance);
+        // KHR_lights_punctual's cone and range factors, which light_at() applies.
+        if (L.spot)
+            o << " cone clamp(-l.axis * " << num(L.cone_scale) << " + " << num(L.cone_offset) << ", 0, 1)^2";
+        if (L.point && L.range_inv2 > 0.0f) o << " range " << num(1.0f / std::sqrt(L.range_inv2));
+        o << "\n";
     }
     // What lights the frame besides the lights: an environment (then the
     // ambient term is not used) or the ambient colour.

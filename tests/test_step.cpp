@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -1107,6 +1108,31 @@ TEST_CASE("tile: the filters pick the bins of one triangle and of one pixel, whi
     CHECK(sum_covered == covered);
 }
 
+TEST_CASE("frame names a spot light's cone and range as light_at() applies them") {
+    CliSandbox box;
+    GltfWriter g;
+    const int pos = g.floats({-1, -1, 0, 1, -1, 0, 0, 1, 0}, "VEC3", 3);
+    g.doc["meshes"].push_back({{"primitives", json::array({{{"attributes", {{"POSITION", pos}}}}})}});
+    g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    g.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array(
+        {{{"type", "spot"}, {"intensity", 5}, {"range", 4}, {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.5}}}}});
+    g.doc["nodes"] = json::array({{{"mesh", 0}}, {{"translation", {0, 0, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}});
+    g.doc["scenes"] = json::array({{{"nodes", {0, 1}}}});
+    write_text(box.path("spot.gltf"), g.text());
+    const CliRun r = run_step(box, {box.path("spot.gltf"), "--size", "32x32"}, "frame\n");
+    REQUIRE(r.code == 0);
+    // scale = 1 / (cos 0.2 - cos 0.5), offset = -cos 0.5 scale (KHR_lights_punctual).
+    const double scale = 1.0 / (std::cos(0.2) - std::cos(0.5)), offset = -std::cos(0.5) * scale;
+    const std::string head = "light 0: spot at (0, 0, 2) shining along (0, 0, -1) radiance (5, 5, 5) cone clamp(-l.axis * ";
+    const std::size_t at = r.out.find(head);
+    REQUIRE(at != std::string::npos);
+    double got_scale = 0, got_offset = 0;
+    REQUIRE(std::sscanf(r.out.c_str() + at + head.size(), "%lf + %lf, 0, 1)^2 range 4", &got_scale, &got_offset) == 2);
+    CHECK(got_scale == doctest::Approx(scale).epsilon(1e-6));
+    CHECK(got_offset == doctest::Approx(offset).epsilon(1e-6));
+    CHECK(r.out.find(", 0, 1)^2 range 4\n", at) != std::string::npos);
+}
+
 } // TEST_SUITE
 
 TEST_SUITE("readme") {
@@ -1145,5 +1171,6 @@ TEST_CASE("README: the install paragraph lists exactly the packages of scripts/i
     CHECK(want.size() >= 12);
     CHECK(got == want);
 }
+
 
 } // TEST_SUITE
