@@ -534,6 +534,170 @@ function explain(x, y) {
   }
 }
 
+// ---------------------------------------------------------------- views: draws and textures
+
+// A table row that selects: cells as text, a click calls `pick`.
+function pickRow(cells, pick) {
+  const tr = el("tr", "pick");
+  for (const c of cells) tr.appendChild(typeof c === "string" ? el("td", "", c) : c);
+  tr.addEventListener("click", () => pick(tr));
+  return tr;
+}
+
+function choose(tbody, tr) {
+  for (const r of tbody.children) r.classList.toggle("chosen", r === tr);
+}
+
+const panelError = (id, e) => { $(id).textContent = "error: " + e.message; };
+
+// Each list loads when its panel first opens, so the page's load stays as before.
+const views = { draws: null, textures: null, vertices: null, texture: null, texView: null, zoom: "fit" };
+
+async function loadDraws() {
+  if (views.draws) return;
+  try {
+    views.draws = (await api("/api/draws")).draws;
+  } catch (e) { panelError("draw-text", e); return; }
+  $("draws-count").textContent = "(" + views.draws.length + ")";
+  const body = $("draws").querySelector("tbody");
+  body.textContent = "";
+  for (const d of views.draws) {
+    const prims = d.topology === "triangles" ? String(d.primitives) : d.primitives + " " + d.topology;
+    body.appendChild(pickRow([String(d.draw), d.mesh_name, d.material_name, prims, d.alpha,
+                              el("td", d.visible ? "" : "culled", d.visible ? "visible" : "culled")],
+                             (tr) => { choose(body, tr); showDraw(d.draw); }));
+  }
+}
+
+async function showDraw(n) {
+  const links = $("draw-links");
+  try {
+    const d = await api("/api/draw?n=" + n);
+    $("draw-text").textContent = d.text;
+    links.textContent = "";
+    const a = el("a", "tri", "its vertices");
+    a.addEventListener("click", () => showVertices(n, 0));
+    links.appendChild(a);
+    links.appendChild(document.createTextNode(" (" + d.mesh_name + ", " + d.program + ")"));
+  } catch (e) { links.textContent = ""; panelError("draw-text", e); }
+}
+
+const VERTEX_ROWS = 16;
+async function showVertices(n, first) {
+  $("vertices-box").hidden = false;
+  try {
+    const v = await api("/api/vertices?draw=" + n + "&first=" + first + "&count=" + VERTEX_ROWS);
+    views.vertices = { draw: n, first: first, count: v.vertex_count };
+    const last = first + v.vertices.length;
+    $("vertices-title").textContent = "draw " + n + ": vertices " + first + ".." + (last - 1) + " of " + v.vertex_count;
+    $("vertices-more").disabled = last >= v.vertex_count;
+    $("vertices-text").textContent = v.text;
+  } catch (e) { $("vertices-more").disabled = true; panelError("vertices-text", e); }
+}
+
+async function loadTextures() {
+  if (views.textures) return;
+  try {
+    views.textures = (await api("/api/textures")).textures;
+  } catch (e) { panelError("texture-text", e); return; }
+  const body = $("textures").querySelector("tbody");
+  body.textContent = "";
+  for (const t of views.textures) {
+    const tr = pickRow([t.id, t.kind, t.width + "x" + t.height, String(t.levels), t.format.split(";")[0]],
+                       (row) => { choose(body, row); pickTexture(t, 0); });
+    tr.dataset.id = t.id;
+    tr.title = t.format;
+    body.appendChild(tr);
+  }
+}
+
+function pickTexture(t, level) {
+  views.texture = t;
+  const sel = $("texture-level");
+  sel.textContent = "";
+  for (const l of t.level_sizes) {
+    const o = el("option", "", "level " + l.level + " (" + l.width + "x" + l.height + ")");
+    o.value = String(l.level);
+    sel.appendChild(o);
+  }
+  sel.value = String(level);
+  $("texture-name").textContent = t.id;
+  const uses = $("texture-uses");
+  uses.textContent = "";
+  for (const u of t.images.concat(t.uses)) uses.appendChild(el("li", "", u));
+  showTexture();
+}
+
+// The level's metadata first, then its PNG (loaded aside, swapped in when it arrived).
+let textureRequest = 0;
+async function showTexture() {
+  const t = views.texture, level = Number($("texture-level").value), ticket = ++textureRequest;
+  let v;
+  try {
+    v = await api("/api/texture?id=" + encodeURIComponent(t.id) + "&level=" + level);
+  } catch (e) { panelError("texture-text", e); return; }
+  if (ticket !== textureRequest) return;
+  const size = v.level_sizes[level];
+  $("texture-line").textContent = "texture " + v.id + ", level " + level + " of " + v.levels + ": " + size.width +
+    "x" + size.height + ", " + v.format + (v.note ? "; " + v.note : "") + ". Shown as: " + v.png_rule + ".";
+  $("texture-text").textContent = v.text;
+  const url = v.png.endpoint + "?id=" + encodeURIComponent(v.png.id) + "&level=" + v.png.level;
+  const loader = new Image();
+  loader.onload = () => {
+    if (ticket !== textureRequest) return;
+    views.texView = { width: loader.naturalWidth, height: loader.naturalHeight };
+    $("texture-image").src = url;
+    $("texture-view").classList.remove("empty");
+    showChannel(loader);
+  };
+  loader.onerror = () => {
+    if (ticket === textureRequest) $("texture-text").textContent = "error: the image " + url + " could not be drawn";
+  };
+  loader.src = url;
+}
+
+// RGB shows the PNG itself; one channel is drawn as grey into the canvas.
+function showChannel(source) {
+  const img = $("texture-image"), c = $("texture-canvas"), ch = $("texture-channel").value;
+  if (!views.texView) return;
+  img.hidden = ch !== "rgb";
+  c.hidden = ch === "rgb";
+  if (ch !== "rgb") {
+    const { width, height } = views.texView, k = "rgba".indexOf(ch);
+    c.width = width;
+    c.height = height;
+    const g = c.getContext("2d", { willReadFrequently: true });
+    g.clearRect(0, 0, width, height);
+    g.drawImage(source || img, 0, 0);
+    const d = g.getImageData(0, 0, width, height), p = d.data;
+    for (let i = 0; i < p.length; i += 4) {
+      const v = p[i + k];
+      p[i] = p[i + 1] = p[i + 2] = v;
+      p[i + 3] = 255;
+    }
+    g.putImageData(d, 0, 0);
+  }
+  placeTexture();
+}
+
+// Zoom: "fit" (the whole level in the box, enlarged or not), 1 or 4 texels per device pixel.
+function placeTexture() {
+  const t = views.texView, box = $("texture-view");
+  if (!t) return;
+  const dpr = window.devicePixelRatio || 1;
+  let s;
+  if (views.zoom === "fit") {
+    const maxH = parseFloat(getComputedStyle(box).maxHeight) || 384;
+    s = Math.min((box.clientWidth || 300) / t.width, maxH / t.height);
+  } else s = views.zoom / dpr;
+  for (const e of [$("texture-image"), $("texture-canvas")]) {
+    e.style.width = t.width * s + "px";
+    e.style.height = t.height * s + "px";
+  }
+  for (const [id, z] of [["texture-fit", "fit"], ["texture-one", 1], ["texture-four", 4]])
+    $(id).classList.toggle("on", views.zoom === z);
+}
+
 // ---------------------------------------------------------------- input
 
 const drag = { down: false, moved: false, x: 0, y: 0, id: null };
@@ -664,6 +828,7 @@ v.addEventListener("pointerleave", () => { state.hover = null; showValue(); });
 v.addEventListener("wheel", onWheel, { passive: false });
 v.addEventListener("keydown", onKey);
 new ResizeObserver(onResize).observe(v);
+window.addEventListener("resize", () => views.zoom === "fit" && placeTexture());
 $("fit").addEventListener("click", () => state.frame && fitView());
 $("one").addEventListener("click", () => state.frame && oneToOne());
 $("zoom-in").addEventListener("click", () => state.frame && zoomBy(2));
@@ -688,4 +853,17 @@ $("upto").addEventListener("input", () => {
 $("grid").addEventListener("change", drawOverlay);
 $("tri-go").addEventListener("click", () => showTriangle(Number($("tri").value), false));
 $("tri").addEventListener("keydown", (ev) => { if (ev.key === "Enter") showTriangle(Number($("tri").value), false); });
+$("draws-panel").addEventListener("toggle", () => { if ($("draws-panel").open) loadDraws(); });
+$("vertices-more").addEventListener("click", () => {
+  const v = views.vertices;
+  if (v && v.first + VERTEX_ROWS < v.count) showVertices(v.draw, v.first + VERTEX_ROWS);
+});
+$("textures-panel").addEventListener("toggle", () => {
+  if ($("textures-panel").open) { loadTextures(); placeTexture(); }
+});
+$("texture-level").addEventListener("change", () => views.texture && showTexture());
+$("texture-channel").addEventListener("change", () => showChannel(null));
+$("texture-fit").addEventListener("click", () => { views.zoom = "fit"; placeTexture(); });
+$("texture-one").addEventListener("click", () => { views.zoom = 1; placeTexture(); });
+$("texture-four").addEventListener("click", () => { views.zoom = 4; placeTexture(); });
 start();

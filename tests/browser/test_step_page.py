@@ -13,7 +13,9 @@ scroll, the panels reachable with the image still in view; a click after a
 4x and a 16x wheel zoom selects the pixel computed from the image's rect;
 the value under the pointer; the keyboard; the "tri N" link brings its
 panel into view; the depth stage's legend; the slider's note; the message
-once the server is stopped. And the `--out DIR` page: every image has its
+once the server is stopped. The Draws and Textures panels (loaded when
+opened): 25 draws, draw 24's state and vertices, the env texture's level 2
+at its JSON's size, zoom and channel. And the `--out DIR` page: every image has its
 PNG's aspect, the depth figure its legend. Screenshots: /tmp/h3-*.png.
 
 usage: test_step_page.py STEP_EXE [--api]
@@ -430,6 +432,7 @@ def page_checks(driver, step, server, url):
     assert driver.find_element(By.ID, "tile-text").get_attribute("textContent") == \
         step_text(step, "tile %d %d\n" % (tx, ty))
     print("tile %d %d: the page shows step's bins exactly" % (tx, ty))
+    view_panel_checks(driver, wait, url.rstrip("/"))
 
     # The depth stage: its image, its sentence and its legend (near to far).
     set_viewport(driver, 1600, 1000)
@@ -516,9 +519,95 @@ def page_checks(driver, step, server, url):
     assert driver.find_element(By.ID, "pixel-text").get_attribute("textContent") == text_before
     view.send_keys("+")
     assert not driver.find_element(By.ID, "zoom-value").text.endswith("(fit)")
+    # A view panel says so in its own text.
+    row = driver.find_elements(By.CSS_SELECTOR, "#draws tbody tr")[3]
+    driver.execute_script("arguments[0].scrollIntoView({block: 'center'})", row)
+    row.click()
+    wait.until(lambda d: d.find_element(By.ID, "draw-text").get_attribute("textContent").startswith(
+        "error: the step server stopped"))
     driver.save_screenshot("/tmp/h3-stopped.png")
     print("stopped server: \"%s\"; the image and the texts stay, zoom still works"
           % driver.find_element(By.ID, "status").text)
+
+
+def view_panel_checks(driver, wait, base):
+    """The Draws and Textures panels: loaded when opened, the texts those of
+    the API (the `serve` test ties the API to the terminal), the texture's
+    level the size its JSON gives. At 1280x800: /tmp/h6-views-1280x800.png,
+    /tmp/h6-textures-1280x800.png."""
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import Select
+    set_viewport(driver, 1280, 800)
+    text = lambda i: driver.find_element(By.ID, i).get_attribute("textContent")  # noqa: E731
+    assert not driver.find_elements(By.CSS_SELECTOR, "#draws tbody tr"), "the draws loaded before the panel opened"
+    driver.find_element(By.CSS_SELECTOR, "#draws-panel > summary").click()
+    wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#draws tbody tr")) == 25)
+    row = driver.find_elements(By.CSS_SELECTOR, "#draws tbody tr")[24]
+    assert [c.text for c in row.find_elements(By.TAG_NAME, "td")] == ["24", "floor", "tiles", "128", "OPAQUE",
+                                                                     "visible"], row.text
+    driver.execute_script("arguments[0].scrollIntoView({block: 'center'})", row)
+    row.click()
+    wait.until(lambda d: text("draw-text").startswith("draw 24:"))
+    assert "floor" in text("draw-text") and text("draw-text") == get(base + "/api/draw?n=24")[1]["text"]
+    driver.find_element(By.CSS_SELECTOR, "#draw-links a").click()
+    first = get(base + "/api/vertices?draw=24&first=0&count=16")[1]["text"]
+    wait.until(lambda d: text("vertices-text") == first)
+    more = get(base + "/api/vertices?draw=24&first=16&count=16")[1]["text"]
+    driver.find_element(By.ID, "vertices-more").click()
+    wait.until(lambda d: text("vertices-text") == more)
+    assert text("vertices-title") == "draw 24: vertices 16..31 of 81", text("vertices-title")
+    print("draws: 25 rows, row 24 shows draw 24 ('floor'), its vertices 0..15 then 16..31 as the API gives them")
+
+    textures = get(base + "/api/textures")[1]["textures"]
+    env = [t for t in textures if t["id"] == "env"][0]
+    driver.find_element(By.CSS_SELECTOR, "#textures-panel > summary").click()
+    wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#textures tbody tr")) == len(textures))
+    row = driver.find_element(By.CSS_SELECTOR, "#textures tbody tr[data-id='env']")
+    driver.execute_script("arguments[0].scrollIntoView({block: 'center'})", row)
+    row.click()
+    Select(driver.find_element(By.ID, "texture-level")).select_by_value("2")
+    img = driver.find_element(By.ID, "texture-image")
+    wait.until(lambda d: "id=env&level=2" in (img.get_attribute("src") or "") and d.execute_script(
+        "return arguments[0].complete && arguments[0].naturalWidth > 0", img))
+    size = env["level_sizes"][2]
+    natural = driver.execute_script("return [arguments[0].naturalWidth, arguments[0].naturalHeight]", img)
+    assert natural == [size["width"], size["height"]], (natural, size)
+    wait.until(lambda d: text("texture-text") == get(base + "/api/texture?id=env&level=2")[1]["text"])
+    line = text("texture-line")
+    assert "level 2 of 8: %dx%d" % (size["width"], size["height"]) in line, line
+    assert [li.text for li in driver.find_elements(By.CSS_SELECTOR, "#texture-uses li")] == env["images"] + env["uses"]
+    assert img.value_of_css_property("image-rendering") == "pixelated"
+    driver.find_element(By.ID, "texture-four").click()
+    assert rect(driver, img)[2] - rect(driver, img)[0] == 4 * size["width"]
+    driver.find_element(By.ID, "texture-one").click()
+    assert rect(driver, img)[2] - rect(driver, img)[0] == size["width"]
+    Select(driver.find_element(By.ID, "texture-channel")).select_by_value("r")
+    canvas = driver.find_element(By.ID, "texture-canvas")
+    assert canvas.is_displayed() and not img.is_displayed()
+    assert driver.execute_script("return [arguments[0].width, arguments[0].height]", canvas) == natural
+    # Each texel of the canvas is grey, the PNG's red.
+    off = driver.execute_script("""
+        const [img, c] = arguments, t = document.createElement('canvas');
+        t.width = img.naturalWidth; t.height = img.naturalHeight;
+        const g = t.getContext('2d');
+        g.drawImage(img, 0, 0);
+        const a = g.getImageData(0, 0, t.width, t.height).data;
+        const b = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let off = 0;
+        for (let i = 0; i < a.length; i += 4)
+          if (b[i] !== a[i] || b[i + 1] !== a[i] || b[i + 2] !== a[i] || b[i + 3] !== 255) ++off;
+        return off;""", img, canvas)
+    assert off == 0, ("texels of the R view that are not the PNG's red as grey", off)
+    Select(driver.find_element(By.ID, "texture-channel")).select_by_value("rgb")
+    driver.find_element(By.ID, "texture-fit").click()
+    fitted = rect(driver, img)
+    assert abs((fitted[2] - fitted[0]) / (fitted[3] - fitted[1]) - size["width"] / size["height"]) < 0.01
+    driver.execute_script("document.getElementById('draws-panel').scrollIntoView({block: 'start'})")
+    driver.save_screenshot("/tmp/h6-views-1280x800.png")
+    driver.execute_script("document.getElementById('textures-panel').scrollIntoView({block: 'start'})")
+    driver.save_screenshot("/tmp/h6-textures-1280x800.png")
+    print("textures: env level 2 shown at %dx%d as its JSON says, pixelated, 4x / 1:1 / fit, channel R in a canvas"
+          % tuple(natural))
 
 
 def large_frame_checks(driver, step):
