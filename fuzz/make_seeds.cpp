@@ -376,6 +376,31 @@ void gltf_seeds() {
         R"("channels":[{"sampler":0,"target":{"node":1,"path":"rotation"}},{"sampler":1,"target":{"node":2,"path":"weights"}},)"
         R"({"sampler":2,"target":{"node":3,"path":"translation"}}]}]})";
     put("gltf", "skin-morph-animation.gltf", skin);
+    // KHR_texture_transform on each kind of texture reference (offset,
+    // rotation, scale, texCoord override), KHR_materials_unlit, and spot
+    // and ranged lights (KHR_lights_punctual).
+    put("gltf", "extensions.gltf",
+        R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_texture_transform","KHR_materials_unlit","KHR_lights_punctual"],)"
+        R"("extensionsRequired":["KHR_texture_transform"],)"
+        R"("extensions":{"KHR_lights_punctual":{"lights":[{"type":"spot","intensity":4,"range":3,)"
+        R"("spot":{"innerConeAngle":0.1,"outerConeAngle":0.6}},{"type":"point","range":0.5},{"type":"spot"}]}},)"
+        R"("buffers":[{"uri":"b.bin","byteLength":256}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":24}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},)"
+        R"({"bufferView":1,"componentType":5126,"count":3,"type":"VEC2"}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1,"TEXCOORD_1":1},"material":0},)"
+        R"({"attributes":{"POSITION":0,"TEXCOORD_0":1},"material":1}]}],)"
+        R"("nodes":[{"mesh":0},{"translation":[0,0,2],"extensions":{"KHR_lights_punctual":{"light":0}}},)"
+        R"({"rotation":[0,0.7071,0,0.7071],"extensions":{"KHR_lights_punctual":{"light":1}}},)"
+        R"({"extensions":{"KHR_lights_punctual":{"light":2}}}],"scenes":[{"nodes":[0,1,2,3]}],)"
+        R"("images":[{"uri":"t.png"}],"samplers":[{"magFilter":9728}],"textures":[{"source":0,"sampler":0}],)"
+        R"("materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0,"extensions":{"KHR_texture_transform":)"
+        R"({"offset":[0.5,-0.25],"rotation":1.5707963,"scale":[2,0.5]}}},"metallicRoughnessTexture":{"index":0,)"
+        R"("extensions":{"KHR_texture_transform":{"texCoord":1,"scale":[1e30,-1e-30]}}}},)"
+        R"("normalTexture":{"index":0,"extensions":{"KHR_texture_transform":{"rotation":"x","offset":[1]}}},)"
+        R"("emissiveTexture":{"index":0,"extensions":{"KHR_texture_transform":{"texCoord":7}}}},)"
+        R"({"extensions":{"KHR_materials_unlit":{}},"pbrMetallicRoughness":{"baseColorFactor":[0.2,0.4,0.6,0.5],)"
+        R"("baseColorTexture":{"index":0}},"alphaMode":"BLEND"}]})");
     put("gltf", "min-version.gltf",
         R"({"asset":{"version":"2.1","minVersion":"2.1"},"buffers":[{"uri":"b.bin","byteLength":256}],)"
         R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
