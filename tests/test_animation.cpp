@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/cli_util.h"
+#include "tests/gltf_writer.h"
 
 #include "scene/animation.h"
 #include "scene/load_scene.h"
@@ -33,64 +34,15 @@ const std::string kRender = PRAST_RENDER_EXE;
 const std::string kStep = PRAST_STEP_EXE;
 const double kPi = 3.14159265358979323846;
 
-std::string base64(const std::vector<unsigned char>& in) {
-    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (std::size_t i = 0; i < in.size(); i += 3) {
-        const std::uint32_t b = std::uint32_t(in[i]) << 16 | (i + 1 < in.size() ? std::uint32_t(in[i + 1]) << 8 : 0u) |
-                                (i + 2 < in.size() ? std::uint32_t(in[i + 2]) : 0u);
-        out += table[b >> 18 & 63];
-        out += table[b >> 12 & 63];
-        out += i + 1 < in.size() ? table[b >> 6 & 63] : '=';
-        out += i + 2 < in.size() ? table[b & 63] : '=';
-    }
-    return out;
-}
-
-// A glTF document with one data-URI buffer that accessors append to.
-struct Gltf {
-    json doc = json::object();
-    std::vector<unsigned char> bin;
-
-    Gltf() {
-        doc["asset"] = {{"version", "2.0"}};
-        for (const char* k : {"accessors", "bufferViews", "nodes", "meshes"}) doc[k] = json::array();
-    }
-    int add_raw(const void* data, std::size_t bytes, int component, const char* type, std::size_t count) {
-        while (bin.size() % 4) bin.push_back(0);
-        const std::size_t offset = bin.size();
-        bin.insert(bin.end(), static_cast<const unsigned char*>(data), static_cast<const unsigned char*>(data) + bytes);
-        doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}});
-        doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1},
-                                    {"componentType", component},
-                                    {"type", type},
-                                    {"count", count}});
-        return int(doc["accessors"].size()) - 1;
-    }
+// The tests' glTF writer (tests/gltf_writer.h), written into a sandbox.
+// Hostile files write NaN: their float accessors carry no min and max.
+struct Gltf : prast::gltf_test::GltfWriter {
     int floats(const std::vector<float>& v, const char* type, int per) {
-        const int a = add_raw(v.data(), v.size() * 4, 5126, type, v.size() / std::size_t(per));
-        if (per == 3 && std::all_of(v.begin(), v.end(), [](float x) { return std::isfinite(x); })) {
-            // POSITION needs min and max (harmless on the other VEC3s).
-            std::vector<float> lo(3, 1e30f), hi(3, -1e30f);
-            for (std::size_t i = 0; i < v.size(); ++i) {
-                lo[i % 3] = std::min(lo[i % 3], v[i]);
-                hi[i % 3] = std::max(hi[i % 3], v[i]);
-            }
-            doc["accessors"][std::size_t(a)]["min"] = lo;
-            doc["accessors"][std::size_t(a)]["max"] = hi;
-        }
-        return a;
+        if (std::all_of(v.begin(), v.end(), [](float x) { return std::isfinite(x); }))
+            return GltfWriter::floats(v, type, per);
+        return add_raw(v.data(), v.size() * 4, 5126, type, v.size() / std::size_t(per));
     }
-    int u16(const std::vector<std::uint16_t>& v, const char* type, int per) {
-        return add_raw(v.data(), v.size() * 2, 5123, type, v.size() / std::size_t(per));
-    }
-    std::string text() {
-        json d = doc;
-        d["buffers"] = json::array({{{"byteLength", bin.size()},
-                                     {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
-        return d.dump();
-    }
-    std::string write(const CliSandbox& box, const std::string& name) {
+    std::string write(const CliSandbox& box, const std::string& name) const {
         write_text(box.path(name), text());
         return box.path(name);
     }
