@@ -18,6 +18,7 @@
 
 #include <stb_image_write.h>
 
+#include "tests/gltf_writer.h"
 #include "tests/scratch.h"
 
 #include "scene/load_scene.h"
@@ -48,21 +49,6 @@ std::vector<unsigned char> tiny_png() {
             v->insert(v->end(), static_cast<unsigned char*>(data), static_cast<unsigned char*>(data) + size);
         },
         &out, 2, 2, 3, rgb, 6);
-    return out;
-}
-
-std::string base64(const std::vector<unsigned char>& in) {
-    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (std::size_t i = 0; i < in.size(); i += 3) {
-        const std::uint32_t b = std::uint32_t(in[i]) << 16 |
-                                (i + 1 < in.size() ? std::uint32_t(in[i + 1]) << 8 : 0u) |
-                                (i + 2 < in.size() ? std::uint32_t(in[i + 2]) : 0u);
-        out += table[b >> 18 & 63];
-        out += table[b >> 12 & 63];
-        out += i + 1 < in.size() ? table[b >> 6 & 63] : '=';
-        out += i + 2 < in.size() ? table[b & 63] : '=';
-    }
     return out;
 }
 
@@ -229,7 +215,7 @@ const char* kQuadGltf = R"({
 })";
 
 std::string data_uri(const std::vector<unsigned char>& bytes, const char* mime) {
-    return std::string("data:") + mime + ";base64," + base64(bytes);
+    return std::string("data:") + mime + ";base64," + prast::gltf_test::base64(bytes);
 }
 
 // The .gltf text with a data-URI buffer and a data-URI PNG.
