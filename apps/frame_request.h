@@ -24,6 +24,7 @@ inline FrameRequest render_frame_request(const RenderOptions& opt) {
     r.lights = opt.lights;
     r.ambient = opt.ambient;
     r.ambient_given = opt.ambient_given;
+    r.file_lights = opt.file_lights;
     r.no_default_lights = opt.no_default_lights;
     r.brdf = opt.brdf;
     r.env = opt.env;

@@ -390,11 +390,18 @@ void print_pixel_ibl(SceneRenderer& sr, const FrameSettings& settings, const Mes
     ShadingContext ctx = sr.shading_context(settings);
     ctx.lights.clear();  // the environment's share alone
     const IblTerms t = ibl_terms(ms, sp, ctx);
-    const glm::vec3 split = t.diffuse + t.specular;
+    const glm::vec3 split = ibl_sum(t);  // with the sheen's and the clear coat's lobes where the material has them
     const glm::vec3 ref = ibl_reference(ms, sp, ctx, samples);
-    std::printf("  ibl split-sum %.6g %.6g %.6g = diffuse %.6g %.6g %.6g + specular %.6g %.6g %.6g\n",
+    std::printf("  ibl split-sum %.6g %.6g %.6g = diffuse %.6g %.6g %.6g + specular %.6g %.6g %.6g",
                 double(split.r), double(split.g), double(split.b), double(t.diffuse.r), double(t.diffuse.g),
                 double(t.diffuse.b), double(t.specular.r), double(t.specular.g), double(t.specular.b));
+    if (t.sheen)
+        std::printf(" + sheen %.6g %.6g %.6g", double(t.sheen_specular.r), double(t.sheen_specular.g),
+                    double(t.sheen_specular.b));
+    if (t.coat)
+        std::printf(" + clear coat %.6g %.6g %.6g", double(t.coat_specular.r), double(t.coat_specular.g),
+                    double(t.coat_specular.b));
+    std::printf("\n");
     std::printf("  ibl terms: irradiance %.6g %.6g %.6g prefiltered %.6g %.6g %.6g level %.4f "
                 "dfg scale %.6g bias %.6g diffuse %.6g n.v %.4f occlusion %.4g\n",
                 double(t.irradiance.r), double(t.irradiance.g), double(t.irradiance.b), double(t.prefiltered.r),

@@ -66,6 +66,7 @@ struct RenderOptions {
     std::vector<ShadingLight> lights;  // --sun and --point, in command-line order
     glm::vec3 ambient{0.03f};
     bool ambient_given = false;
+    bool file_lights = true;                 // --file-lights off: the flags' lights replace the file's
     bool no_default_lights = false;
     // Image-based lighting (the built-in scene has a sky of its own).
     std::string env;                   // --env FILE.hdr

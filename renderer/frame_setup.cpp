@@ -71,7 +71,7 @@ CameraFault FrameSetup::set_frame(int index, double radians) {
         pose_scene(scene, t, animation);
         time = t;
         // The file's lights move with their nodes.
-        settings.lights = frame_lights(scene, request.lights, request.no_default_lights,
+        settings.lights = frame_lights(scene, request.lights, request.file_lights, request.no_default_lights,
                                        scene.environment || !request.env.empty(), used_default_rig);
         bounds = first_bounds;
         const Bounds now = scene.bounds();
@@ -141,7 +141,7 @@ FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameSt
     // The lights: the scene's and the flags'; the default rig only when
     // neither has any and no environment (--env, or the scene's own sky)
     // lights the scene.
-    out.settings.lights = frame_lights(out.scene, req.lights, req.no_default_lights,
+    out.settings.lights = frame_lights(out.scene, req.lights, req.file_lights, req.no_default_lights,
                                        out.scene.environment || !req.env.empty(), out.used_default_rig);
 
     // The whole job must fit in memory before anything big is allocated.

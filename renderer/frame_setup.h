@@ -46,6 +46,7 @@ struct FrameRequest {
     std::vector<ShadingLight> lights;        // from the flags, in order
     glm::vec3 ambient{0.03f};
     bool ambient_given = false;              // notes that an environment replaces it
+    bool file_lights = true;                 // the file's KHR_lights_punctual lights (--file-lights)
     bool no_default_lights = false;
     BrdfModel brdf = BrdfModel::Default;
     std::string env;                         // an .hdr file; empty: the scene's own, if any

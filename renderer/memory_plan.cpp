@@ -61,6 +61,7 @@ MemoryPlan plan_memory(const Scene& scene, int width, int height, std::uint64_t 
         for (const TextureRef* r : {&m.base_color, &m.emissive}) used.insert({r->image, true});
         for (const TextureRef* r : {&m.metallic_roughness, &m.roughness, &m.metallic, &m.normal, &m.occlusion})
             used.insert({r->image, false});
+        for (const TextureRef* r : m.extension_textures()) used.insert({r->image, m.extension_texture_srgb(r)});
     }
     std::vector<int> per_image(scene.images.size(), 0);
     for (const auto& u : used)

@@ -46,8 +46,10 @@ std::vector<ShadingLight> default_light_rig() {
 }
 
 std::vector<ShadingLight> frame_lights(const Scene& scene, const std::vector<ShadingLight>& flag_lights,
-                                       bool no_default_lights, bool environment, bool& used_default_rig) {
-    std::vector<ShadingLight> lights = shading_lights(scene);
+                                       bool file_lights, bool no_default_lights, bool environment,
+                                       bool& used_default_rig) {
+    std::vector<ShadingLight> lights;
+    if (file_lights) lights = shading_lights(scene);
     lights.insert(lights.end(), flag_lights.begin(), flag_lights.end());
     used_default_rig = lights.empty() && !no_default_lights && !environment;
     if (used_default_rig) lights = default_light_rig();
@@ -67,6 +69,10 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
                                     &m.normal, &m.occlusion})
             if (r->valid() && std::size_t(r->image) < n_images && !first_user[std::size_t(r->image)])
                 first_user[std::size_t(r->image)] = r;
+    for (const Material& m : scene.materials)
+        for (const TextureRef* r : m.extension_textures())
+            if (r->valid() && std::size_t(r->image) < n_images && !first_user[std::size_t(r->image)])
+                first_user[std::size_t(r->image)] = r;
     auto wraps_of = [&](int slot) {
         const TextureRef* u = first_user[std::size_t(slot / 2)];
         return std::make_pair(u ? u->wrap_s : Wrap::Repeat, u ? u->wrap_t : Wrap::Repeat);
@@ -83,6 +89,11 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
         for (auto [r, srgb] : {std::pair{&m.base_color, true}, {&m.emissive, true}, {&m.metallic_roughness, false},
                                {&m.normal, false}, {&m.occlusion, false}})
             if (slot_of(*r, srgb) >= 0) direct[std::size_t(slot_of(*r, srgb))] = 1;
+        // KHR_materials_specular's colour map is sRGB, the other extension maps linear.
+        for (const TextureRef* r : m.extension_textures()) {
+            const int slot = slot_of(*r, m.extension_texture_srgb(r));
+            if (slot >= 0) direct[std::size_t(slot)] = 1;
+        }
         const int rs = slot_of(m.roughness, false), ms = slot_of(m.metallic, false);
         if (rs >= 0 && ms >= 0 && rs != ms && !m.metallic_roughness.valid() && wraps_of(rs) == wraps_of(ms) &&
             m.roughness.texcoord == m.metallic.texcoord && m.roughness.transform == m.metallic.transform) {
@@ -206,6 +217,15 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
             if (!refs[i]->transform.present) continue;
             b.transformed = std::uint8_t(b.transformed | (1u << i));
             b.xf[i] = UvTransform::of(refs[i]->transform);
+        }
+        const std::vector<const TextureRef*> ext = m.extension_textures();
+        for (int i = 0; i < BoundMaterial::kExtMaps; ++i) {
+            const TextureRef& r = *ext[std::size_t(i)];
+            b.ext[i] = bind(r, m.extension_texture_srgb(&r));
+            b.ext_uv[i] = set_of(r);
+            if (!r.transform.present) continue;
+            b.ext_transformed = std::uint8_t(b.ext_transformed | (1u << i));
+            b.ext_xf[i] = UvTransform::of(r.transform);
         }
         bound_.push_back(b);
     }

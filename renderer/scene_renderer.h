@@ -69,11 +69,13 @@ std::vector<ShadingLight> shading_lights(const Scene& scene);
 // upper left front and a weaker, cooler fill from the right.
 std::vector<ShadingLight> default_light_rig();
 
-// The lights of a frame: the scene's, then the flags', and the default rig
-// when neither has any, none was refused (--no-default-lights) and no
-// environment lights the scene; `used_default_rig` says whether it was.
+// The lights of a frame: the scene's (unless `file_lights` is false:
+// --file-lights off), then the flags', and the default rig when neither has
+// any, none was refused (--no-default-lights) and no environment lights the
+// scene; `used_default_rig` says whether it was.
 std::vector<ShadingLight> frame_lights(const Scene& scene, const std::vector<ShadingLight>& flag_lights,
-                                       bool no_default_lights, bool environment, bool& used_default_rig);
+                                       bool file_lights, bool no_default_lights, bool environment,
+                                       bool& used_default_rig);
 
 // One draw of a frame, as SceneRenderer::render submits it: what a tap
 // factory is told before the frame runs.

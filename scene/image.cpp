@@ -1,5 +1,6 @@
 // Image decoding: 8-bit PNG through libpng and zlib (linked statically: their
-// inflate and row filters are several times faster than stb_image's), every
+// inflate and row filters are several times faster than stb_image's), WebP
+// through libwebp (static too; EXT_texture_webp), every
 // other format (JPEG, HDR, 16-bit PNG, ...) through stb_image. 8-bit files
 // keep their bytes, 16-bit and HDR files become linear float RGBA; see image.h.
 #include "scene/image.h"
@@ -24,6 +25,7 @@
 #include <png.h>
 #include <zlib.h>
 #include <stb_image.h>
+#include <webp/decode.h>
 #include <unistd.h>
 
 #include "scene/file_access.h"
@@ -60,6 +62,43 @@ const char* sniff_format(const unsigned char* p, std::size_t n) {
     if (starts("8BPS", 4)) return "PSD";
     if (starts("BM", 2)) return "BMP";
     return nullptr;
+}
+
+// A WebP file (RIFF container, EXT_texture_webp): decoded by libwebp.
+bool is_webp(const unsigned char* p, std::size_t n) {
+    return n >= 12 && std::memcmp(p, "RIFF", 4) == 0 && std::memcmp(p + 8, "WEBP", 4) == 0;
+}
+
+// A WebP (lossless or lossy) can code a flat image in almost no bits, so its
+// size alone bounds nothing: above kWebpFreeTexels, a file must bring a byte
+// per kMaxWebpTexelsPerByte texels (a flat 4096x4096 lossless texture is
+// about 100 bytes: such a file is refused; real textures are far denser),
+// so that a small file cannot make prast allocate a gigabyte for pixels.
+constexpr std::int64_t kWebpFreeTexels = std::int64_t(1) << 20;
+constexpr std::int64_t kMaxWebpTexelsPerByte = 4096;
+
+// "" with the size and channel count (3, or 4 with alpha) from a WebP's
+// header, checked against kMaxImageTexels and the bound above (`file_size`:
+// the whole file's); else why not.
+std::string webp_header(const unsigned char* data, std::size_t size, std::uint64_t file_size, int& w, int& h,
+                        int& channels) {
+    WebPBitstreamFeatures f;
+    if (WebPGetFeatures(data, size, &f) != VP8_STATUS_OK) return "cannot decode WebP image: corrupt or truncated header";
+    if (f.has_animation) return "cannot decode WebP image: animated WebP is not supported";
+    if (f.width <= 0 || f.height <= 0) return "image has zero size";
+    const std::int64_t texels = std::int64_t(f.width) * std::int64_t(f.height);
+    if (texels > kMaxImageTexels)
+        return "image too large: " + std::to_string(f.width) + "x" + std::to_string(f.height) + " = " +
+               std::to_string(texels) + " texels, more than the limit of " + std::to_string(kMaxImageTexels) +
+               " (2^28)";
+    if (texels > kWebpFreeTexels && std::uint64_t(texels) > std::uint64_t(kMaxWebpTexelsPerByte) * file_size)
+        return "cannot decode WebP image: " + std::to_string(f.width) + "x" + std::to_string(f.height) +
+               " texels from only " + std::to_string(file_size) + " bytes (more than " +
+               std::to_string(kMaxWebpTexelsPerByte) + " texels a byte are refused)";
+    w = f.width;
+    h = f.height;
+    channels = f.has_alpha ? 4 : 3;
+    return "";
 }
 
 bool is_png(const unsigned char* p, std::size_t n) {
@@ -631,6 +670,21 @@ Image decode_image(const ImageSource& src, bool srgb) {
     const stbi_uc* data = bytes->data();
     const int len = int(bytes->size());
 
+    if (is_webp(data, bytes->size())) {
+        // Its header's size is checked before libwebp allocates anything.
+        Image img;
+        const std::string refused = webp_header(data, bytes->size(), bytes->size(), img.width, img.height, img.channels);
+        if (!refused.empty()) throw LoadError(name + ": " + refused);
+        const std::size_t row = std::size_t(img.width) * std::size_t(img.channels);
+        img.pixels.resize(row * std::size_t(img.height));
+        const std::uint8_t* ok = img.channels == 4
+            ? WebPDecodeRGBAInto(data, bytes->size(), img.pixels.data(), img.pixels.size(), int(row))
+            : WebPDecodeRGBInto(data, bytes->size(), img.pixels.data(), img.pixels.size(), int(row));
+        if (!ok) throw LoadError(name + ": cannot decode WebP image: corrupt or truncated data");
+        img.srgb = srgb;
+        return img;
+    }
+
     // Through the guards first: stb_image 2.27 can hang on Radiance data and
     // write out of bounds on JPEG data (scene/hdr_guard.h, scene/jpeg_guard.h).
     const std::string unsafe = stb_unsafe(data, bytes->size());
@@ -748,6 +802,14 @@ bool image_dimensions(const ImageSource& src, int& width, int& height, int* byte
     }
     if (bytes->empty() || bytes->size() > std::size_t(INT_MAX)) return false;
     const stbi_uc* data = bytes->data();
+    if (is_webp(data, bytes->size())) {
+        int w = 0, h = 0, channels = 0;
+        if (!webp_header(data, bytes->size(), file_size, w, h, channels).empty()) return false;
+        width = w;
+        height = h;
+        if (bytes_per_texel) *bytes_per_texel = channels;
+        return true;
+    }
     // stbi_info reads a JPEG's tables (guarded); a Radiance header alone is
     // safe, and its pixels are beyond the prefix read here.
     if (!looks_like_hdr(data, bytes->size()) && !stb_unsafe(data, bytes->size()).empty()) return false;

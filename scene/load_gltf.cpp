@@ -47,6 +47,8 @@
 #include "scene/file_access.h"
 #include "scene/image.h"
 #include "scene/gltf_graph.h"
+#include "scene/draco_decode.h"
+#include "scene/meshopt_decode.h"
 #include "scene/messages.h"
 
 namespace prast {
@@ -65,6 +67,12 @@ constexpr int kMaxJsonDepth = 256;
 constexpr std::size_t kMaxAccessorCount = 0x7fffffff;
 // tinygltf's own messages quote the file: a line of theirs is cut to this.
 constexpr std::size_t kMaxLineChars = 2 * kMaxShownChars;
+// Bytes that compressed bufferViews (EXT_meshopt_compression) may decode to,
+// all of a model's together (as much as the largest file read, kMaxFileBytes).
+constexpr std::uint64_t kMaxDecodedBytes = std::uint64_t(1) << 31;
+// Stands in for a uri-less fallback buffer (tinygltf refuses a buffer
+// without data): one zero byte, dropped after parsing.
+constexpr const char* kStandInUri = "data:application/octet-stream;base64,AA==";
 
 // ---- Callbacks handed to tinygltf
 
@@ -248,11 +256,18 @@ TopLevel check_json(const char* s, std::size_t n, const std::string& path) {
 // Others it uses optionally are ignored with a warning where they appear.
 bool implemented_extension(const std::string& ext) {
     static const char* const kImplemented[] = {
+        "EXT_meshopt_compression",
+        "EXT_texture_webp",
+        "KHR_draco_mesh_compression",
         "KHR_lights_punctual",
+        "KHR_materials_clearcoat",
         "KHR_materials_emissive_strength",
         "KHR_materials_ior",
         "KHR_materials_pbrSpecularGlossiness",  // converted to metal-rough at load
+        "KHR_materials_sheen",
+        "KHR_materials_specular",
         "KHR_materials_unlit",
+        "KHR_meshopt_compression",  // its version-0 streams: EXT_meshopt_compression's bitstream
         "KHR_mesh_quantization",
         "KHR_texture_transform",
     };
@@ -299,6 +314,38 @@ std::string decode_uri(const std::string& uri) {
         } else {
             out += uri[i];
         }
+    }
+    return out;
+}
+
+// The bytes of base64 text from `begin` on (RFC 4648; stops at '=' or the
+// end, "" at a character outside the alphabet).
+std::string base64_bytes(const std::string& text, std::size_t begin) {
+    std::string out;
+    std::uint32_t bits = 0;
+    int count = 0;
+    for (std::size_t i = begin; i < text.size() && text[i] != '='; ++i) {
+        const char c = text[i];
+        int v = -1;
+        if (c >= 'A' && c <= 'Z') v = c - 'A';
+        else if (c >= 'a' && c <= 'z') v = c - 'a' + 26;
+        else if (c >= '0' && c <= '9') v = c - '0' + 52;
+        else if (c == '+') v = 62;
+        else if (c == '/') v = 63;
+        if (v < 0) return "";
+        bits = bits << 6 | std::uint32_t(v);
+        if (++count == 4) {
+            out += char(bits >> 16 & 255);
+            out += char(bits >> 8 & 255);
+            out += char(bits & 255);
+            bits = 0;
+            count = 0;
+        }
+    }
+    if (count == 2) out += char(bits >> 4 & 255);
+    if (count == 3) {
+        out += char(bits >> 10 & 255);
+        out += char(bits >> 2 & 255);
     }
     return out;
 }
@@ -394,6 +441,8 @@ public:
     Scene load() {
         parse();
         check_required_extensions();
+        decode_meshopt_views();
+        decode_draco_primitives();
         image_map_.assign(model_.images.size(), kNotYet);
         for (std::size_t i = 0; i < model_.materials.size(); ++i)
             scene_.materials.push_back(convert_material(model_.materials[i], i));
@@ -450,12 +499,15 @@ private:
         std::string err, warnings;
         bool ok = false;
         if (glb) {
-            const std::size_t length = check_glb(bytes, shown_);
+            check_glb(bytes, shown_);
             check_top_level(check_json(reinterpret_cast<const char*>(&bytes[20]), le32(&bytes[12]), shown_));
+            stand_in_fallbacks(bytes, true);
+            const std::size_t length = check_glb(bytes, shown_);
             ok = ctx.LoadBinaryFromMemory(&model_, &err, &warnings, bytes.data(),
                                           static_cast<unsigned int>(length), base_dir_);
         } else {
             check_top_level(check_json(reinterpret_cast<const char*>(bytes.data()), bytes.size(), shown_));
+            stand_in_fallbacks(bytes, false);
             ok = ctx.LoadASCIIFromString(&model_, &err, &warnings,
                                          reinterpret_cast<const char*>(bytes.data()),
                                          static_cast<unsigned int>(bytes.size()), base_dir_);
@@ -502,6 +554,391 @@ private:
             fail("asset.minVersion '" + cut(v) + "' is not a glTF version (MAJOR.MINOR)");
         if (major > 2 || (major == 2 && minor > 0))
             fail("asset.minVersion " + v + " is required, prast loads glTF 2.0");
+    }
+
+    // ---- EXT_meshopt_compression (and KHR_meshopt_compression)
+
+    // A file using meshopt compression may have buffers without a uri (the
+    // fallback that only a decoder fills, as gltfpack writes them; in a .glb
+    // any but buffer 0, the BIN chunk). tinygltf refuses those, so each gets a
+    // one-byte stand-in before parsing and its byteLength is kept here; the
+    // JSON is rewritten only then, other files reach tinygltf unchanged.
+    // Likewise tinygltf refuses a primitive whose indices accessor has no
+    // bufferView, which is how KHR_draco_mesh_compression primitives are
+    // written: such an accessor gets the Draco bufferView (or view 0) as a
+    // stand-in, taken away again after parsing (decode_draco_primitives).
+    void stand_in_fallbacks(std::vector<unsigned char>& bytes, bool glb) {
+        static const std::string kMeshopt = "_meshopt_compression", kDraco = "KHR_draco_mesh_compression";
+        const bool meshopt_named = std::search(bytes.begin(), bytes.end(), kMeshopt.begin(), kMeshopt.end()) != bytes.end();
+        const bool draco_named = std::search(bytes.begin(), bytes.end(), kDraco.begin(), kDraco.end()) != bytes.end();
+        if (!meshopt_named && !draco_named) return;
+        const std::size_t begin = glb ? 20 : 0, length = glb ? le32(&bytes[12]) : bytes.size();
+        nlohmann::json doc = nlohmann::json::parse(bytes.begin() + std::ptrdiff_t(begin),
+                                                   bytes.begin() + std::ptrdiff_t(begin + length), nullptr, false);
+        if (!doc.is_object()) return;  // tinygltf names the problem
+        const auto used = doc.find("extensionsUsed");
+        if (used == doc.end() || !used->is_array()) return;
+        bool meshopt = false, draco = false;
+        for (const nlohmann::json& e : *used) {
+            meshopt = meshopt || e == "EXT_meshopt_compression" || e == "KHR_meshopt_compression";
+            draco = draco || e == "KHR_draco_mesh_compression";
+        }
+        bool changed = draco && stand_in_draco_indices(doc);
+        const auto buffers = doc.find("buffers");
+        if (meshopt && buffers != doc.end() && buffers->is_array())
+        for (std::size_t i = glb ? 1 : 0; i < buffers->size(); ++i) {
+            nlohmann::json& b = (*buffers)[i];
+            if (!b.is_object() || b.contains("uri")) continue;
+            const auto bl = b.find("byteLength");
+            if (bl == b.end() || !bl->is_number_unsigned()) continue;  // tinygltf names the problem
+            fallback_lengths_[i] = bl->get<std::uint64_t>();
+            b["uri"] = kStandInUri;
+            b["byteLength"] = 1;
+            changed = true;
+        }
+        if (!changed) return;
+        std::string text = doc.dump();
+        if (!glb) {
+            bytes.assign(text.begin(), text.end());
+            return;
+        }
+        while (text.size() % 4) text += ' ';  // GLB chunks are 4-byte aligned
+        const std::size_t file_length = le32(&bytes[8]);
+        std::vector<unsigned char> out(bytes.begin(), bytes.begin() + 20);
+        out.insert(out.end(), text.begin(), text.end());
+        out.insert(out.end(), bytes.begin() + std::ptrdiff_t(begin + length), bytes.begin() + std::ptrdiff_t(file_length));
+        const auto put32 = [&](std::size_t at, std::size_t v) {
+            for (int k = 0; k < 4; ++k) out[at + std::size_t(k)] = static_cast<unsigned char>(v >> (8 * k));
+        };
+        put32(8, out.size());
+        put32(12, text.size());
+        bytes = std::move(out);
+    }
+
+    bool stand_in_draco_indices(nlohmann::json& doc) {
+        const auto meshes = doc.find("meshes"), accessors = doc.find("accessors"), views = doc.find("bufferViews");
+        if (meshes == doc.end() || !meshes->is_array() || accessors == doc.end() || !accessors->is_array() ||
+            views == doc.end() || !views->is_array() || views->empty())
+            return false;
+        bool changed = false;
+        for (nlohmann::json& mesh : *meshes) {
+            if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+            for (nlohmann::json& prim : mesh["primitives"]) {
+                if (!prim.is_object() || !prim.contains("indices") || !prim["indices"].is_number_unsigned() ||
+                    !prim.contains("extensions") || !prim["extensions"].is_object() ||
+                    !prim["extensions"].contains("KHR_draco_mesh_compression"))
+                    continue;
+                const std::uint64_t a = prim["indices"].get<std::uint64_t>();
+                if (a >= accessors->size() || !(*accessors)[a].is_object() || (*accessors)[a].contains("bufferView")) continue;
+                const nlohmann::json& ext = prim["extensions"]["KHR_draco_mesh_compression"];
+                std::uint64_t view = 0;
+                if (ext.is_object() && ext.contains("bufferView") && ext["bufferView"].is_number_unsigned() &&
+                    ext["bufferView"].get<std::uint64_t>() < views->size())
+                    view = ext["bufferView"].get<std::uint64_t>();
+                (*accessors)[a]["bufferView"] = view;
+                draco_stand_ins_.insert(std::size_t(a));
+                changed = true;
+            }
+        }
+        return changed;
+    }
+
+    // Every bufferView with the extension decoded into a buffer of its own
+    // (the view then points at it), so that accessors, images and the graph
+    // read it as any other. Checked first: the extension's rules, the source
+    // range, that the stream can hold what it claims (meshopt::min_encoded_size,
+    // before the output is allocated) and kMaxDecodedBytes. A stream that does
+    // not decode is refused naming the extension, unless the view's own buffer
+    // holds the uncompressed data (then a warning and that data).
+    void decode_meshopt_views() {
+        std::set<std::size_t> stand_ins;
+        for (const auto& [i, bytes] : fallback_lengths_) {
+            (void)bytes;
+            if (i < model_.buffers.size()) {
+                model_.buffers[i].data.clear();
+                stand_ins.insert(i);
+            }
+        }
+        const std::size_t original_buffers = model_.buffers.size();
+        for (std::size_t v = 0; v < model_.bufferViews.size(); ++v) {
+            tinygltf::BufferView& bv = model_.bufferViews[v];
+            const char* name = "EXT_meshopt_compression";
+            auto ext = bv.extensions.find(name);
+            if (ext == bv.extensions.end()) {
+                name = "KHR_meshopt_compression";
+                ext = bv.extensions.find(name);
+            }
+            if (ext == bv.extensions.end()) {
+                if (bv.buffer >= 0 && stand_ins.count(std::size_t(bv.buffer)))
+                    fail("bufferView " + std::to_string(v) + ": buffer " + std::to_string(bv.buffer) +
+                         " is a uri-less meshopt fallback (no data), and the bufferView has no "
+                         "EXT_meshopt_compression to decode");
+                continue;
+            }
+            decode_meshopt_view(v, name, ext->second, stand_ins, original_buffers);
+        }
+    }
+
+    void decode_meshopt_view(std::size_t v, const std::string& name, const tinygltf::Value& e,
+                             const std::set<std::size_t>& stand_ins, std::size_t original_buffers) {
+        tinygltf::BufferView& bv = model_.bufferViews[v];
+        const std::string what = "bufferView " + std::to_string(v) + ": " + name;
+        if (!e.IsObject()) fail(what + ": not an object");
+        const auto integer = [&](const char* key, bool required, std::uint64_t fallback) -> std::uint64_t {
+            const tinygltf::Value& x = e.Get(key);
+            if (x.Type() == tinygltf::NULL_TYPE) {
+                if (required) fail(what + ": no " + key);
+                return fallback;
+            }
+            const double d = x.IsNumber() ? x.GetNumberAsDouble() : -1.0;
+            if (!(d >= 0.0 && d <= 9007199254740992.0 && d == std::floor(d)))
+                fail(what + ": " + key + " is not a non-negative integer");
+            return std::uint64_t(d);
+        };
+        const auto text = [&](const char* key, const char* fallback) -> std::string {
+            const tinygltf::Value& x = e.Get(key);
+            if (x.Type() == tinygltf::NULL_TYPE) {
+                if (!fallback) fail(what + ": no " + key);
+                return fallback;
+            }
+            if (!x.IsString()) fail(what + ": " + key + " is not a string");
+            return x.Get<std::string>();
+        };
+        const std::uint64_t buffer = integer("buffer", true, 0), offset = integer("byteOffset", false, 0),
+                            length = integer("byteLength", true, 0), stride = integer("byteStride", true, 0),
+                            count = integer("count", true, 0);
+        const std::string mode_name = text("mode", nullptr), filter_name = text("filter", "NONE");
+        meshopt::Mode mode = meshopt::Mode::Attributes;
+        if (mode_name == "TRIANGLES") mode = meshopt::Mode::Triangles;
+        else if (mode_name == "INDICES") mode = meshopt::Mode::Indices;
+        else if (mode_name != "ATTRIBUTES")
+            fail(what + ": mode '" + cut(mode_name) + "' is not ATTRIBUTES, TRIANGLES or INDICES");
+        meshopt::Filter filter = meshopt::Filter::None;
+        if (filter_name == "OCTAHEDRAL") filter = meshopt::Filter::Octahedral;
+        else if (filter_name == "QUATERNION") filter = meshopt::Filter::Quaternion;
+        else if (filter_name == "EXPONENTIAL") filter = meshopt::Filter::Exponential;
+        else if (filter_name == "COLOR") fail(what + ": filter COLOR is not supported");
+        else if (filter_name != "NONE")
+            fail(what + ": filter '" + cut(filter_name) + "' is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL");
+        // The extension's rules, which also keep count * stride from overflowing.
+        if (count > kMaxAccessorCount) fail(what + ": absurd count " + std::to_string(count));
+        if (mode == meshopt::Mode::Attributes) {
+            if (stride == 0 || stride % 4 != 0 || stride > 256)
+                fail(what + ": byteStride " + std::to_string(stride) + " (ATTRIBUTES need a multiple of 4 up to 256)");
+        } else {
+            if (stride != 2 && stride != 4)
+                fail(what + ": byteStride " + std::to_string(stride) + " (" + mode_name + " need 2 or 4)");
+            if (filter != meshopt::Filter::None) fail(what + ": a filter on " + mode_name);
+            if (mode == meshopt::Mode::Triangles && count % 3 != 0)
+                fail(what + ": count " + std::to_string(count) + " is not a multiple of 3 (TRIANGLES)");
+        }
+        if ((filter == meshopt::Filter::Octahedral && stride != 4 && stride != 8) ||
+            (filter == meshopt::Filter::Quaternion && stride != 8))
+            fail(what + ": byteStride " + std::to_string(stride) + " does not suit filter " + filter_name);
+        if (bv.byteStride != 0 && bv.byteStride != stride)
+            fail(what + ": byteStride " + std::to_string(stride) + " differs from the bufferView's " +
+                 std::to_string(bv.byteStride));
+        if (std::uint64_t(bv.byteLength) != count * stride)
+            fail(what + ": count " + std::to_string(count) + " times byteStride " + std::to_string(stride) +
+                 " is not the bufferView's byteLength " + std::to_string(bv.byteLength));
+        if (buffer >= original_buffers || stand_ins.count(std::size_t(buffer)))
+            fail(what + ": buffer " + std::to_string(buffer) + (buffer >= original_buffers ? " out of range" : " has no data"));
+        const std::vector<unsigned char>& src = model_.buffers[std::size_t(buffer)].data;
+        if (offset > src.size() || length > src.size() - offset)
+            fail(what + ": byteOffset " + std::to_string(offset) + " + byteLength " + std::to_string(length) +
+                 " exceeds buffer " + std::to_string(buffer) + " (" + std::to_string(src.size()) + " bytes)");
+        // Before allocating: can these bytes hold what the file claims?
+        const std::size_t least = meshopt::min_encoded_size(mode, std::size_t(count), std::size_t(stride));
+        std::string why;
+        tinygltf::Buffer decoded;
+        if (length < least) {
+            why = std::to_string(length) + " compressed bytes cannot hold " + std::to_string(count) +
+                  " elements of " + std::to_string(stride) + " bytes (at least " + std::to_string(least) + " needed)";
+        } else {
+            decoded_bytes_ += bv.byteLength;
+            if (decoded_bytes_ > kMaxDecodedBytes)
+                fail(what + ": decoding brings the model's decompressed data to " + std::to_string(decoded_bytes_) +
+                     " bytes, more than the limit of " + std::to_string(kMaxDecodedBytes) + " (2 GiB)");
+            decoded.data.resize(bv.byteLength);
+            why = meshopt::decode(mode, filter, src.data() + offset, std::size_t(length), std::size_t(count),
+                                  std::size_t(stride), decoded.data.data());
+        }
+        if (!why.empty()) {
+            const bool has_fallback = bv.buffer >= 0 && std::size_t(bv.buffer) < original_buffers &&
+                                      !stand_ins.count(std::size_t(bv.buffer)) &&
+                                      bv.byteOffset <= model_.buffers[std::size_t(bv.buffer)].data.size() &&
+                                      bv.byteLength <= model_.buffers[std::size_t(bv.buffer)].data.size() - bv.byteOffset;
+            if (!has_fallback) fail(what + ": cannot decode: " + why);
+            warn(what + ": cannot decode (" + why + "), its uncompressed fallback data used");
+            return;
+        }
+        model_.buffers.push_back(std::move(decoded));
+        bv.buffer = int(model_.buffers.size()) - 1;
+        bv.byteOffset = 0;
+    }
+
+    // ---- KHR_draco_mesh_compression
+
+    // Each primitive with the extension decoded once (however many nodes
+    // draw its mesh) into a buffer of its own: its accessors and indices then
+    // point at views of it, and are read as any other. Before libdraco sees
+    // the stream, its header's face and vertex counts are held to the
+    // indices' and POSITION accessors' counts (each within kMaxSceneElements),
+    // so that a hostile count is refused before anything is allocated for it;
+    // after decoding, every accessor's count, type and componentType must be
+    // the decoded attribute's. A primitive that does not decode is refused
+    // naming the extension, unless all its accessors have uncompressed data.
+    void decode_draco_primitives() {
+        for (std::size_t a : draco_stand_ins_)
+            if (a < model_.accessors.size()) model_.accessors[a].bufferView = -1;
+        for (std::size_t m = 0; m < model_.meshes.size(); ++m)
+            for (std::size_t p = 0; p < model_.meshes[m].primitives.size(); ++p) {
+                tinygltf::Primitive& prim = model_.meshes[m].primitives[p];
+                const auto ext = prim.extensions.find("KHR_draco_mesh_compression");
+                if (ext == prim.extensions.end()) continue;
+                const std::string what = "mesh " + std::to_string(m) + " primitive " + std::to_string(p) +
+                                         ": KHR_draco_mesh_compression";
+                std::string why;
+                if (decode_draco(prim, ext->second, what, why)) continue;
+                bool fallback = prim.indices >= 0;
+                for (const auto& [name, index] : prim.attributes) {
+                    (void)name;
+                    fallback = fallback && index >= 0 && std::size_t(index) < model_.accessors.size() &&
+                               model_.accessors[std::size_t(index)].bufferView >= 0;
+                }
+                if (prim.indices >= 0 && std::size_t(prim.indices) < model_.accessors.size())
+                    fallback = fallback && model_.accessors[std::size_t(prim.indices)].bufferView >= 0;
+                if (!fallback) fail(what + ": " + why);
+                warn(what + ": " + why + "; its uncompressed accessors used");
+            }
+    }
+
+    // False with `why` when the primitive cannot be decoded; a JSON error fails.
+    bool decode_draco(tinygltf::Primitive& prim, const tinygltf::Value& e, const std::string& what, std::string& why) {
+        if (!e.IsObject() || !e.Get("bufferView").IsNumber() || !e.Get("attributes").IsObject())
+            fail(what + ": needs a bufferView and an attributes object");
+        const double view_number = e.Get("bufferView").GetNumberAsDouble();
+        if (!(view_number >= 0.0 && view_number < double(model_.bufferViews.size()) && view_number == std::floor(view_number)))
+            fail(what + ": bufferView " +
+                 (std::fabs(view_number) < 1e15 && view_number == std::floor(view_number)
+                      ? std::to_string(std::int64_t(view_number)) : std::to_string(view_number)) +
+                 " out of range (" + std::to_string(model_.bufferViews.size()) + " bufferViews)");
+        const tinygltf::BufferView& bv = model_.bufferViews[std::size_t(view_number)];
+        if (bv.buffer < 0 || std::size_t(bv.buffer) >= model_.buffers.size() ||
+            bv.byteOffset > model_.buffers[std::size_t(bv.buffer)].data.size() ||
+            bv.byteLength > model_.buffers[std::size_t(bv.buffer)].data.size() - bv.byteOffset)
+            fail(what + ": bufferView " + std::to_string(std::size_t(view_number)) + " exceeds its buffer");
+        const unsigned char* data = model_.buffers[std::size_t(bv.buffer)].data.data() + bv.byteOffset;
+        // The attributes it decodes: glTF name -> Draco unique id, each with its accessor.
+        struct Wanted {
+            std::string name;
+            int id = -1, accessor = -1;
+        };
+        std::vector<Wanted> wanted;
+        const tinygltf::Value& attrs = e.Get("attributes");
+        for (const std::string& key : attrs.Keys()) {
+            const tinygltf::Value& id = attrs.Get(key);
+            const double d = id.IsNumber() ? id.GetNumberAsDouble() : -1.0;
+            if (!(d >= 0.0 && d <= 2147483647.0 && d == std::floor(d)))
+                fail(what + ": attribute " + cut(key) + " has no Draco id (a non-negative integer)");
+            const auto it = prim.attributes.find(key);
+            if (it == prim.attributes.end() || it->second < 0 || std::size_t(it->second) >= model_.accessors.size())
+                fail(what + ": attribute " + cut(key) + " has no accessor in the primitive");
+            wanted.push_back({key, int(d), it->second});
+        }
+        const auto position = std::find_if(wanted.begin(), wanted.end(), [](const Wanted& w) { return w.name == "POSITION"; });
+        if (position == wanted.end()) fail(what + ": no POSITION among its attributes");
+        if (prim.indices < 0 || std::size_t(prim.indices) >= model_.accessors.size())
+            fail(what + ": the primitive needs an indices accessor");
+        const int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+        if (mode != TINYGLTF_MODE_TRIANGLES) fail(what + ": only TRIANGLES primitives (mode 4) are supported");
+        tinygltf::Accessor& indices = model_.accessors[std::size_t(prim.indices)];
+        const std::uint64_t points = model_.accessors[std::size_t(position->accessor)].count;
+        if (points > scene_detail::kMaxSceneElements || indices.count > scene_detail::kMaxSceneElements)
+            fail(what + ": accessor counts " + std::to_string(points) + " and " + std::to_string(indices.count) +
+                 " exceed the limit of " + std::to_string(scene_detail::kMaxSceneElements) + " (2^27)");
+        // The stream's own claims, before libdraco allocates for them.
+        draco_gltf::Counts counts;
+        why = draco_gltf::read_counts(data, bv.byteLength, counts);
+        if (!why.empty()) return false;
+        if (counts.faces * 3 != indices.count) {
+            why = "the stream has " + std::to_string(counts.faces) + " faces, the indices accessor " +
+                  std::to_string(indices.count) + " indices";
+            return false;
+        }
+        if (counts.vertices > points) {
+            why = "the stream has " + std::to_string(counts.vertices) + " vertices, POSITION " + std::to_string(points);
+            return false;
+        }
+        // What the decoded data will take, against the model's decoding budget.
+        std::uint64_t bytes = indices.count * 4;
+        for (const Wanted& w : wanted) {
+            const tinygltf::Accessor& a = model_.accessors[std::size_t(w.accessor)];
+            bytes += a.count * std::uint64_t(std::max(1, type_components(a.type))) *
+                     std::uint64_t(std::max<std::size_t>(1, component_size(a.componentType)));
+        }
+        decoded_bytes_ += bytes;
+        if (decoded_bytes_ > kMaxDecodedBytes)
+            fail(what + ": decoding brings the model's decompressed data to " + std::to_string(decoded_bytes_) +
+                 " bytes, more than the limit of " + std::to_string(kMaxDecodedBytes) + " (2 GiB)");
+        std::vector<int> ids;
+        for (const Wanted& w : wanted) ids.push_back(w.id);
+        draco_gltf::Mesh mesh;
+        why = draco_gltf::decode(data, bv.byteLength, ids, mesh);
+        if (!why.empty()) return false;
+        // Everything checked against the accessors before any is changed.
+        if (mesh.indices.size() != indices.count) {
+            why = "decoded " + std::to_string(mesh.indices.size()) + " indices, the accessor has " +
+                  std::to_string(indices.count);
+            return false;
+        }
+        const int ict = indices.componentType;
+        const std::uint64_t index_limit = ict == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ? 0xff
+                                          : ict == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 0xffff
+                                          : ict == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT ? 0xffffffffu : 0;
+        if (index_limit == 0) fail(what + ": indices componentType " + std::to_string(ict) + " (must be an unsigned integer)");
+        if (mesh.points - (mesh.points ? 1 : 0) > index_limit) {
+            why = std::to_string(mesh.points) + " points do not fit the indices' componentType";
+            return false;
+        }
+        for (const Wanted& w : wanted) {
+            const tinygltf::Accessor& a = model_.accessors[std::size_t(w.accessor)];
+            const draco_gltf::Attribute& d = mesh.attributes.at(w.id);
+            const std::string name = "attribute " + cut(w.name) + " (Draco id " + std::to_string(w.id) + ")";
+            if (a.count != mesh.points) {
+                why = name + ": accessor count " + std::to_string(a.count) + ", decoded " + std::to_string(mesh.points) + " points";
+                return false;
+            }
+            if (d.components != type_components(a.type) || d.component_type != a.componentType) {
+                why = name + ": decoded " + std::to_string(d.components) + " components of componentType " +
+                      std::to_string(d.component_type) + ", the accessor has " + std::to_string(type_components(a.type)) +
+                      " of " + std::to_string(a.componentType);
+                return false;
+            }
+            if (a.sparse.isSparse) fail(what + ": " + name + ": a sparse accessor cannot be Draco-compressed");
+        }
+        // The decoded data in one new buffer, a view per accessor.
+        tinygltf::Buffer out;
+        const auto add_view = [&](const std::vector<unsigned char>& b, tinygltf::Accessor& a) {
+            while (out.data.size() % 4) out.data.push_back(0);
+            tinygltf::BufferView view;
+            view.buffer = int(model_.buffers.size());
+            view.byteOffset = out.data.size();
+            view.byteLength = b.size();
+            out.data.insert(out.data.end(), b.begin(), b.end());
+            model_.bufferViews.push_back(view);
+            a.bufferView = int(model_.bufferViews.size()) - 1;
+            a.byteOffset = 0;
+        };
+        std::vector<unsigned char> packed(mesh.indices.size() * component_size(ict));
+        for (std::size_t i = 0; i < mesh.indices.size(); ++i)
+            for (std::size_t k = 0; k < component_size(ict); ++k)
+                packed[i * component_size(ict) + k] = static_cast<unsigned char>(mesh.indices[i] >> (8 * k));
+        add_view(packed, indices);
+        for (const Wanted& w : wanted)
+            add_view(mesh.attributes.at(w.id).bytes, model_.accessors[std::size_t(w.accessor)]);
+        model_.buffers.push_back(std::move(out));
+        return true;
     }
 
     void check_required_extensions() {
@@ -637,6 +1074,16 @@ private:
                 warn("image " + std::to_string(i) + ": bad bufferView, texture ignored");
                 return -1;
             }
+        } else if (img.image.empty() && img.uri.compare(0, 5, "data:") == 0) {
+            // A data URI whose type tinygltf does not decode (image/webp, EXT_texture_webp).
+            const std::size_t marker = img.uri.find(";base64,");
+            const std::string decoded =
+                marker == std::string::npos ? std::string() : base64_bytes(img.uri, marker + 8);
+            if (decoded.empty()) {
+                warn("image " + std::to_string(i) + ": data URI without base64 data, texture ignored");
+                return -1;
+            }
+            src.bytes.assign(decoded.begin(), decoded.end());
         } else if (!img.uri.empty()) {
             const FileScope::Resolved where = scope_.resolve(scope_.root(), decode_uri(img.uri));
             if (!where.ok()) {
@@ -762,11 +1209,12 @@ private:
         ref.texcoord = texcoord;
         if (xt != extensions.end()) texture_transform(xt->second, what, ref);
         const tinygltf::Texture& tex = model_.textures[std::size_t(index)];
-        if (tex.source < 0 || std::size_t(tex.source) >= model_.images.size()) {
+        const int source = texture_source(tex, index);
+        if (source < 0 || std::size_t(source) >= model_.images.size()) {
             warn(what + ": texture " + std::to_string(index) + " has no usable image source, ignored");
             return ref;
         }
-        ref.image = image_for(tex.source);
+        ref.image = image_for(source);
         if (tex.sampler >= 0) {
             if (std::size_t(tex.sampler) >= model_.samplers.size()) {
                 warn(what + ": sampler " + std::to_string(tex.sampler) + " out of range, REPEAT used");
@@ -785,6 +1233,26 @@ private:
             }
         }
         return ref;
+    }
+
+    // The image a texture draws: EXT_texture_webp's source when it names an
+    // image (WebP preferred; the texture's own source is the PNG/JPEG
+    // fallback), else the texture's source. KHR_texture_basisu (KTX2) has no
+    // decoder here: its fallback source is used, with one warning (a file
+    // requiring it was refused by check_required_extensions).
+    int texture_source(const tinygltf::Texture& tex, int index) {
+        const auto webp = tex.extensions.find("EXT_texture_webp");
+        if (webp != tex.extensions.end()) {
+            const tinygltf::Value& s = webp->second.IsObject() ? webp->second.Get("source") : tinygltf::Value();
+            const double d = s.IsNumber() ? s.GetNumberAsDouble() : -1.0;
+            if (d >= 0.0 && d < double(model_.images.size()) && d == std::floor(d)) return int(d);
+            warn("texture " + std::to_string(index) + ": EXT_texture_webp source is not an image index, " +
+                 (tex.source >= 0 ? "its fallback source used" : "no image"));
+        }
+        if (tex.extensions.count("KHR_texture_basisu"))
+            warn_once(std::string("KHR_texture_basisu (KTX2) textures are not decoded (no decoder in Debian 12): ") +
+                      "their PNG/JPEG source images are used where present");
+        return tex.source;
     }
 
     // ---- KHR_texture_transform
@@ -962,6 +1430,12 @@ private:
             } else if (name == "KHR_materials_unlit") {
                 // A flag: its object's members (none are defined) are not read.
                 m.unlit = true;
+            } else if (name == "KHR_materials_specular") {
+                specular_extension(value, m, what, index);
+            } else if (name == "KHR_materials_clearcoat") {
+                clearcoat_extension(value, m, what, index);
+            } else if (name == "KHR_materials_sheen") {
+                sheen_extension(value, m, what, index);
             } else if (name != "KHR_materials_pbrSpecularGlossiness") {
                 warn(what + ": extension " + cut(name) + " ignored");
             }
@@ -969,6 +1443,139 @@ private:
         const auto sg = g.extensions.find("KHR_materials_pbrSpecularGlossiness");
         if (sg != g.extensions.end()) specular_glossiness(sg->second, m, what);
         return m;
+    }
+
+    // ---- KHR_materials_specular and KHR_materials_clearcoat
+
+    // A number member of a material extension: `fallback` when absent or not
+    // a finite number (warned), clamped to [lo, hi] (warned when outside).
+    float extension_number(const tinygltf::Value& v, const char* key, float fallback, float lo, float hi,
+                           const std::string& what) {
+        const auto shown = [](double d) {
+            char b[32];
+            std::snprintf(b, sizeof b, "%g", d);
+            return std::string(b);
+        };
+        const tinygltf::Value& x = v.Get(key);
+        if (x.Type() == tinygltf::NULL_TYPE) return fallback;
+        const double d = x.IsNumber() ? x.GetNumberAsDouble() : std::nan("");
+        if (!std::isfinite(d)) {
+            warn(what + ": bad " + key + " (not a finite number), " + shown(fallback) + " used");
+            return fallback;
+        }
+        if (d < double(lo) || d > double(hi)) {
+            const float c = float(std::clamp(d, double(lo), double(hi)));
+            warn(what + ": " + key + " " + shown(d) + " outside [" + shown(lo) + ", " + shown(hi) + "], clamped to " +
+                 shown(c));
+            return c;
+        }
+        return float(d);
+    }
+
+    // A textureInfo member of a material extension, with its own
+    // KHR_texture_transform, as texture() reads the core ones.
+    TextureRef material_extension_texture(const tinygltf::Value& v, const char* key, const std::string& what,
+                                          std::size_t material, float* scale = nullptr) {
+        const tinygltf::Value& t = v.Get(key);
+        if (t.Type() == tinygltf::NULL_TYPE) return {};
+        if (!t.IsObject() || !t.Get("index").IsNumber()) {
+            warn(what + " " + key + ": not a textureInfo, ignored");
+            return {};
+        }
+        const double index = t.Get("index").GetNumberAsDouble();
+        const tinygltf::Value& tc = t.Get("texCoord");
+        const double texcoord = tc.IsNumber() ? tc.GetNumberAsDouble() : 0.0;
+        tinygltf::ExtensionMap extensions;
+        const tinygltf::Value& ext = t.Get("extensions");
+        if (ext.IsObject())
+            for (const std::string& k : ext.Keys()) extensions[k] = ext.Get(k);
+        if (scale) *scale = extension_number(t, "scale", 1.0f, -3.0e38f, 3.0e38f, what + " " + key);
+        // Out-of-int indices and sets are refused by texture() as out of range.
+        const int ii = index >= 0.0 && index < 2.0e9 ? int(index) : -2;
+        if (ii == -2 || index != std::floor(index)) {
+            warn(what + " " + key + ": texture index not a non-negative integer, ignored");
+            return {};
+        }
+        const int set = texcoord >= 0.0 && texcoord < 2.0e9 && texcoord == std::floor(texcoord) ? int(texcoord) : -1;
+        return texture(ii, set, extensions, what + " " + key, material, "", "");
+    }
+
+    void specular_extension(const tinygltf::Value& v, Material& m, const std::string& what_material,
+                            std::size_t index) {
+        const std::string what = what_material + " KHR_materials_specular";
+        if (!v.IsObject()) {
+            warn(what + ": not an object, ignored");
+            return;
+        }
+        m.has_specular = true;
+        m.specular_factor = extension_number(v, "specularFactor", 1.0f, 0.0f, 1.0f, what);
+        const tinygltf::Value& c = v.Get("specularColorFactor");
+        if (c.Type() != tinygltf::NULL_TYPE) {
+            bool ok = c.IsArray() && c.ArrayLen() == 3;
+            for (int i = 0; ok && i < 3; ++i)
+                ok = c.Get(i).IsNumber() && std::isfinite(c.Get(i).GetNumberAsDouble()) &&
+                     std::fabs(c.Get(i).GetNumberAsDouble()) <= 3.0e38;
+            if (!ok) {
+                warn(what + ": bad specularColorFactor (not three finite numbers), [1, 1, 1] used");
+            } else {
+                bool negative = false;
+                for (int i = 0; i < 3; ++i) {
+                    const double d = c.Get(i).GetNumberAsDouble();
+                    negative = negative || d < 0.0;
+                    m.specular_color_factor[i] = float(std::max(d, 0.0));
+                }
+                if (negative) warn(what + ": negative specularColorFactor, clamped to 0");
+            }
+        }
+        m.specular_texture = material_extension_texture(v, "specularTexture", what, index);
+        m.specular_color_texture = material_extension_texture(v, "specularColorTexture", what, index);
+    }
+
+    void clearcoat_extension(const tinygltf::Value& v, Material& m, const std::string& what_material,
+                             std::size_t index) {
+        const std::string what = what_material + " KHR_materials_clearcoat";
+        if (!v.IsObject()) {
+            warn(what + ": not an object, ignored");
+            return;
+        }
+        m.clearcoat_factor = extension_number(v, "clearcoatFactor", 0.0f, 0.0f, 1.0f, what);
+        m.clearcoat_roughness_factor = extension_number(v, "clearcoatRoughnessFactor", 0.0f, 0.0f, 1.0f, what);
+        m.clearcoat_texture = material_extension_texture(v, "clearcoatTexture", what, index);
+        m.clearcoat_roughness_texture = material_extension_texture(v, "clearcoatRoughnessTexture", what, index);
+        m.clearcoat_normal_texture =
+            material_extension_texture(v, "clearcoatNormalTexture", what, index, &m.clearcoat_normal_scale);
+        // clearcoatFactor 0 is no coat (the extension: the layer is off):
+        // the material keeps the bytes it has without the extension.
+        m.has_clearcoat = m.clearcoat_factor > 0.0f;
+    }
+
+    void sheen_extension(const tinygltf::Value& v, Material& m, const std::string& what_material, std::size_t index) {
+        const std::string what = what_material + " KHR_materials_sheen";
+        if (!v.IsObject()) {
+            warn(what + ": not an object, ignored");
+            return;
+        }
+        const tinygltf::Value& c = v.Get("sheenColorFactor");
+        if (c.Type() != tinygltf::NULL_TYPE) {
+            bool ok = c.IsArray() && c.ArrayLen() == 3;
+            for (int i = 0; ok && i < 3; ++i) ok = c.Get(i).IsNumber() && std::isfinite(c.Get(i).GetNumberAsDouble());
+            if (!ok) {
+                warn(what + ": bad sheenColorFactor (not three finite numbers), [0, 0, 0] used");
+            } else {
+                bool outside = false;
+                for (int i = 0; i < 3; ++i) {
+                    const double d = c.Get(i).GetNumberAsDouble();
+                    outside = outside || d < 0.0 || d > 1.0;
+                    m.sheen_color_factor[i] = float(std::clamp(d, 0.0, 1.0));
+                }
+                if (outside) warn(what + ": sheenColorFactor outside [0, 1], clamped");
+            }
+        }
+        m.sheen_roughness_factor = extension_number(v, "sheenRoughnessFactor", 0.0f, 0.0f, 1.0f, what);
+        m.sheen_color_texture = material_extension_texture(v, "sheenColorTexture", what, index);
+        m.sheen_roughness_texture = material_extension_texture(v, "sheenRoughnessTexture", what, index);
+        // A black sheen colour disables the layer (the extension): the bytes of the file without it.
+        m.has_sheen = m.sheen_color_factor != glm::vec3(0.0f);
     }
 
     // ---- KHR_materials_pbrSpecularGlossiness, converted to metal-rough
@@ -1382,6 +1989,8 @@ private:
         for (const TextureRef* t : {&m.base_color, &m.metallic_roughness, &m.roughness, &m.metallic, &m.normal,
                                     &m.occlusion, &m.emissive})
             if (t->valid() && t->texcoord == 1) return true;
+        for (const TextureRef* t : m.extension_textures())
+            if (t->valid() && t->texcoord == 1) return true;
         return false;
     }
 
@@ -1590,6 +2199,9 @@ private:
     std::set<std::string> warned_;
     std::size_t elements_ = 0;     // accessor elements read
     std::size_t zero_filled_ = 0;  // of which made up (no bufferView)
+    std::map<std::size_t, std::uint64_t> fallback_lengths_;  // stood-in meshopt fallback buffers: byteLength
+    std::uint64_t decoded_bytes_ = 0;                         // by decode_meshopt_views
+    std::set<std::size_t> draco_stand_ins_;                   // indices accessors given a bufferView to parse
     std::map<std::string, int> image_by_path_;
 };
 

@@ -101,6 +101,46 @@ struct Material {
     // KHR_materials_unlit: the colour is the base colour term (factor x
     // texture x vertex colour), no light, environment or emissive.
     bool unlit = false;
+
+    // KHR_materials_specular: the dielectric's F0 = min(F0(ior) x colour, 1)
+    // x specular and F90 = specular (docs/shading.md). Off: F0(ior) and 1,
+    // the arithmetic of files without it unchanged.
+    bool has_specular = false;
+    float specular_factor = 1.0f;              // [0, 1]
+    glm::vec3 specular_color_factor{1.0f};     // >= 0 (the product is clamped to 1)
+    TextureRef specular_texture;               // A
+    TextureRef specular_color_texture;         // sRGB, RGB
+
+    // KHR_materials_clearcoat: a second GGX lobe (F0 0.04) over the base,
+    // which it attenuates by 1 - clearcoat F_coat(n_c.v). Off (or factor 0):
+    // no coat at all.
+    bool has_clearcoat = false;
+    float clearcoat_factor = 0.0f;             // [0, 1]
+    float clearcoat_roughness_factor = 0.0f;   // [0, 1]
+    float clearcoat_normal_scale = 1.0f;
+    TextureRef clearcoat_texture;              // R
+    TextureRef clearcoat_roughness_texture;    // G
+    TextureRef clearcoat_normal_texture;       // tangent space; none: the geometric normal
+
+    // KHR_materials_sheen: a Charlie lobe over the base, which keeps what it
+    // leaves (albedo scaling). Off (or colour 0): no sheen at all.
+    bool has_sheen = false;
+    glm::vec3 sheen_color_factor{0.0f};        // [0, 1]
+    float sheen_roughness_factor = 0.0f;       // [0, 1]
+    TextureRef sheen_color_texture;            // sRGB, RGB
+    TextureRef sheen_roughness_texture;        // A
+
+    // The extension textures above, for code that walks every map (in
+    // BoundMaterial::ExtMap's order).
+    std::vector<const TextureRef*> extension_textures() const {
+        return {&specular_texture, &specular_color_texture, &clearcoat_texture, &clearcoat_roughness_texture,
+                &clearcoat_normal_texture, &sheen_color_texture, &sheen_roughness_texture};
+    }
+    // Which of them hold sRGB colour (the others are linear data).
+    bool extension_texture_srgb(const TextureRef* r) const {
+        return r == &specular_color_texture || r == &sheen_color_texture;
+    }
+    bool layered() const { return has_specular || has_clearcoat || has_sheen; }
 };
 
 struct Mesh {

@@ -1,6 +1,7 @@
 #!/bin/sh
 # Installs the Debian 12 packages prast builds with (compiler, CMake, the
-# header-only libraries, and zlib and libpng, linked statically). Runs apt-get through sudo unless already root.
+# header-only libraries, and zlib, libpng, libwebp and libdraco, linked statically;
+# libmeshoptimizer only for the tests, which encode with it). Runs apt-get through sudo unless already root.
 set -e
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
@@ -18,6 +19,9 @@ PACKAGES="
   libpng-dev
   libedit-dev
   pkg-config
+  libdraco-dev
+  libwebp-dev
+  libmeshoptimizer-dev
 "
 missing=""
 for p in $PACKAGES; do

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -156,6 +157,122 @@ inline ConductorIOR conductor_ior(Conductor c) {
     return {glm::vec3(1.5f), glm::vec3(0.0f)};
 }
 
+// ---- Sheen (KHR_materials_sheen)
+
+namespace brdf_detail {
+// exp and log from plain double arithmetic (range reduction and fixed
+// series), so the sheen's powers do not depend on which libm variant the
+// CPU selects: relative error < 1e-14 on the ranges the sheen uses.
+inline double det_exp(double x) {
+    if (!(x > -700.0)) return 0.0;  // also NaN
+    if (x > 700.0) x = 700.0;
+    const double k = std::floor(x * 1.4426950408889634 + 0.5);
+    const double r = (x - k * 0.693145751953125) - k * 1.4286068203094173e-06;  // ln 2 in two parts
+    double term = 1.0, sum = 1.0;
+    for (int i = 1; i <= 14; ++i) {
+        term = term * r / double(i);
+        sum += term;
+    }
+    return std::ldexp(sum, int(k));
+}
+// x > 0 and finite.
+inline double det_log(double x) {
+    int e = 0;
+    double m = std::frexp(x, &e);  // m in [0.5, 1)
+    if (m < 0.70710678118654752) {
+        m *= 2.0;
+        --e;
+    }
+    const double t = (m - 1.0) / (m + 1.0), t2 = t * t;  // |t| <= 0.1716
+    double term = t, sum = 0.0;
+    for (int i = 0; i < 12; ++i) {
+        sum += term / double(2 * i + 1);
+        term *= t2;
+    }
+    return 2.0 * sum + double(e) * 0.69314718055994531;
+}
+inline double det_pow(double x, double y) { return x > 0.0 ? det_exp(y * det_log(x)) : 0.0; }
+} // namespace brdf_detail
+
+// The "Charlie" sheen distribution (Conty Estevez and Kulla 2017), alpha =
+// r^2: (2 + 1/alpha) sin(theta_h)^(1/alpha) / (2 pi).
+inline double D_Charlie(double NoH, double alpha) {
+    const double inv = 1.0 / alpha;
+    const double sin2 = 1.0 - NoH * NoH;
+    return (2.0 + inv) * brdf_detail::det_pow(sin2, 0.5 * inv) / (2.0 * glm::pi<double>());
+}
+
+// Their visibility, with the fitted Lambda the extension gives.
+inline double sheen_lambda(double cos_theta, double alpha) {
+    const double t = (1.0 - alpha) * (1.0 - alpha);
+    const auto l = [&](double x) {
+        const double a = 21.5473 + (25.3245 - 21.5473) * t, b = 3.82987 + (3.32435 - 3.82987) * t;
+        const double c = 0.19823 + (0.16801 - 0.19823) * t, d = -1.97760 + (-1.27393 + 1.97760) * t;
+        const double e = -4.32054 + (-4.85967 + 4.32054) * t;
+        return a / (1.0 + b * brdf_detail::det_pow(x, c)) + d * x + e;
+    };
+    return cos_theta < 0.5 ? brdf_detail::det_exp(l(cos_theta))
+                           : brdf_detail::det_exp(2.0 * l(0.5) - l(1.0 - cos_theta));
+}
+inline double V_Charlie(double NoV, double NoL, double alpha) {
+    const double den = (1.0 + sheen_lambda(NoV, alpha) + sheen_lambda(NoL, alpha)) * (4.0 * NoV * NoL);
+    return den > 0.0 ? std::min(1.0 / den, 1.0) : 0.0;
+}
+
+// The directional albedo E(n.v, r) of the sheen lobe with colour 1, the
+// integral of D V (n.l) over the hemisphere, for the extension's albedo
+// scaling: a table of kSheenNoV x kSheenRough texels, n.v = i / (kSheenNoV -
+// 1), r = j / (kSheenRough - 1) clamped to [0.045, 1], built once in double
+// by a fixed-order midpoint rule (the same bytes everywhere), read bilinearly.
+constexpr int kSheenNoV = 32, kSheenRough = 16;
+inline const std::array<float, kSheenNoV * kSheenRough>& sheen_albedo_table() {
+    static const std::array<float, kSheenNoV * kSheenRough> table = [] {
+        std::array<float, kSheenNoV * kSheenRough> t{};
+        constexpr int kTheta = 48, kPhi = 48;  // phi over half the circle (the lobe is symmetric)
+        const double pi = glm::pi<double>();
+        for (int j = 0; j < kSheenRough; ++j) {
+            const double r = std::max(double(kMinPerceptualRoughness), double(j) / (kSheenRough - 1));
+            const double alpha = r * r;
+            for (int i = 0; i < kSheenNoV; ++i) {
+                const double NoV = std::max(double(i) / (kSheenNoV - 1), 1e-4);
+                const double sv = std::sqrt(1.0 - NoV * NoV);
+                const double lv = sheen_lambda(NoV, alpha);
+                double sum = 0.0;
+                for (int a = 0; a < kTheta; ++a) {
+                    // Uniform in cos(theta_l): dl = d(cos) dphi. V_Charlie's
+                    // terms, out of the phi loop (V depends on the cosines only).
+                    const double NoL = (a + 0.5) / kTheta, sl = std::sqrt(1.0 - NoL * NoL);
+                    const double V = std::min(1.0 / ((1.0 + lv + sheen_lambda(NoL, alpha)) * (4.0 * NoV * NoL)), 1.0);
+                    double row = 0.0;
+                    for (int b = 0; b < kPhi; ++b) {
+                        const double phi = (b + 0.5) * pi / kPhi;
+                        const double hx = sl * std::cos(phi) + sv, hy = sl * std::sin(phi), hz = NoL + NoV;
+                        const double NoH = hz / std::sqrt(hx * hx + hy * hy + hz * hz);
+                        row += D_Charlie(NoH, alpha);
+                    }
+                    sum += row * V * NoL;
+                }
+                t[std::size_t(j * kSheenNoV + i)] = float(sum * (1.0 / kTheta) * (2.0 * pi / kPhi));
+            }
+        }
+        return t;
+    }();
+    return table;
+}
+inline float sheen_albedo(float NoV, float r) {
+    const auto& t = sheen_albedo_table();
+    float x = NoV * float(kSheenNoV - 1), y = r * float(kSheenRough - 1);
+    x = x > 0.0f ? (x < float(kSheenNoV - 1) ? x : float(kSheenNoV - 1)) : 0.0f;  // NaN -> 0
+    y = y > 0.0f ? (y < float(kSheenRough - 1) ? y : float(kSheenRough - 1)) : 0.0f;
+    const int x0 = std::min(int(x), kSheenNoV - 2), y0 = std::min(int(y), kSheenRough - 2);
+    const float fx = x - float(x0), fy = y - float(y0);
+    const float* row0 = &t[std::size_t(y0 * kSheenNoV)];
+    const float* row1 = row0 + kSheenNoV;
+    const float a = row0[x0] + (row0[x0 + 1] - row0[x0]) * fx;
+    const float b = row1[x0] + (row1[x0 + 1] - row1[x0]) * fx;
+    return a + (b - a) * fy;
+}
+
 // ---- Diffuse
 
 // Lambert: a constant 1 / pi, so that albedo 1 reflects all incident energy.
@@ -193,7 +310,25 @@ struct BrdfInputs {
     // of (1 - F)(1 - metallic).
     bool energy = false;
     glm::vec3 energy_comp{1.0f}, energy_kd{0.0f};
+    // KHR_materials_specular (specular_ext): the dielectric's F0 is
+    // min(F0(ior) specular_color, 1) specular and its F90 specular.
+    bool specular_ext = false;
+    float specular = 1.0f;
+    glm::vec3 specular_color{1.0f};
+    // KHR_materials_clearcoat: the coat's weight (0: no coat, the base's
+    // arithmetic unchanged), perceptual roughness and unit normal.
+    float clearcoat = 0.0f;
+    float clearcoat_roughness = 0.0f;
+    glm::vec3 clearcoat_n{0.0f, 0.0f, 1.0f};
+    // KHR_materials_sheen: the sheen colour (0: no sheen, the base's
+    // arithmetic unchanged) and its perceptual roughness.
+    glm::vec3 sheen_color{0.0f};
+    float sheen_roughness = 0.0f;
+    bool has_sheen() const { return sheen_color.x > 0.0f || sheen_color.y > 0.0f || sheen_color.z > 0.0f; }
 };
+
+// The clear coat's F0: a dielectric of ior 1.5, as KHR_materials_clearcoat fixes it.
+constexpr float kClearcoatF0 = 0.04f;
 
 // F0 of the inputs: the conductor's reflectance at normal incidence, or the
 // conventions' mix of the dielectric's and the albedo by metallic.
@@ -202,7 +337,17 @@ inline glm::vec3 brdf_f0(const BrdfInputs& in) {
         ConductorIOR ior = conductor_ior(in.conductor);
         return F_ConductorSchlick(ior.eta, ior.k, 1.0f);
     }
+    if (in.specular_ext) {
+        const glm::vec3 d = glm::min(glm::vec3(f0_from_ior(in.ior)) * in.specular_color, glm::vec3(1.0f)) * in.specular;
+        return glm::mix(d, in.albedo, in.metallic);
+    }
     return glm::mix(glm::vec3(f0_from_ior(in.ior)), in.albedo, in.metallic);
+}
+
+// F90 of the inputs: 1, or KHR_materials_specular's mix(specular, 1, metallic).
+inline float brdf_f90(const BrdfInputs& in) {
+    if (in.conductor != Conductor::None || !in.specular_ext) return 1.0f;
+    return in.specular * (1.0f - in.metallic) + in.metallic;
 }
 
 // Every intermediate, for the debug stepper. The cosines are clamped to [0, 1].
@@ -212,6 +357,19 @@ struct BrdfTerms {
     float G = 0.0f;  // Gltf: the visibility V = G / (4 n.v n.l)
     glm::vec3 F{0.0f}, kd{0.0f}, diffuse{0.0f}, specular{0.0f};
     glm::vec3 f{0.0f};  // diffuse + specular; the caller multiplies by radiance * n.l
+    // The clear coat (coat true): its cosines about n_c, D, G (or V), its
+    // Fresnel F_coat = F_Schlick(0.04, n_c.v), the base's attenuation
+    // 1 - clearcoat F_coat (already in f) and the lobe clearcoat F_coat D G,
+    // which the caller multiplies by radiance * n_c.l (brdf_light()).
+    bool coat = false;
+    float coat_NoL = 0.0f, coat_NoV = 0.0f, coat_NoH = 0.0f, coat_D = 0.0f, coat_G = 0.0f, coat_F = 0.0f;
+    float coat_attenuation = 1.0f, coat_specular = 0.0f;
+    // The sheen (sheen true): its D and V, the albedo scaling of the base
+    // min(1 - max(colour) E(n.v), 1 - max(colour) E(n.l)) (already in
+    // diffuse and specular) and the lobe colour D V, in f (under the coat).
+    bool sheen = false;
+    float sheen_D = 0.0f, sheen_V = 0.0f, sheen_scaling = 1.0f;
+    glm::vec3 sheen_f{0.0f};
 };
 
 inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
@@ -236,6 +394,11 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
         ConductorIOR ior = conductor_ior(in.conductor);
         t.F = F_ConductorSchlick(ior.eta, ior.k, t.VoH);
         metallic = 1.0f;
+    } else if (in.specular_ext) {
+        // KHR_materials_specular: F0 + (F90 - F0) (1 - v.h)^5.
+        const glm::vec3 F0 = brdf_f0(in);
+        const float F90 = brdf_f90(in);
+        t.F = F0 + (glm::vec3(F90) - F0) * brdf_detail::pow5(1.0f - t.VoH);
     } else {
         glm::vec3 F0 = glm::mix(glm::vec3(f0_from_ior(in.ior)), in.albedo, in.metallic);
         t.F = F_Schlick(F0, t.VoH);
@@ -257,7 +420,61 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
     t.kd = in.energy ? in.energy_kd : (glm::vec3(1.0f) - t.F) * (1.0f - metallic);
     t.diffuse = t.kd * in.albedo * Fd_Lambert();
     t.f = t.diffuse + t.specular;
+    if (in.has_sheen()) {
+        // KHR_materials_sheen: the Charlie lobe over the base, which keeps
+        // what the sheen leaves (the extension's albedo scaling).
+        t.sheen = true;
+        const float rs = glm::clamp(in.sheen_roughness, kMinPerceptualRoughness, 1.0f);
+        const double as = double(rs) * double(rs);
+        t.sheen_D = float(D_Charlie(double(t.NoH), as));
+        t.sheen_V = float(V_Charlie(double(t.NoV), double(t.NoL), as));
+        const float cmax = std::max(in.sheen_color.x, std::max(in.sheen_color.y, in.sheen_color.z));
+        t.sheen_scaling = std::min(1.0f - cmax * sheen_albedo(t.NoV, rs), 1.0f - cmax * sheen_albedo(t.NoL, rs));
+        t.diffuse = t.diffuse * t.sheen_scaling;
+        t.specular = t.specular * t.sheen_scaling;
+        t.sheen_f = in.sheen_color * (t.sheen_D * t.sheen_V);
+        t.f = t.diffuse + t.specular + t.sheen_f;
+    }
+    if (in.clearcoat > 0.0f) {
+        // KHR_materials_clearcoat: a GGX lobe about the coat's normal with the
+        // coat's roughness and the extension's fresnel_coat, Schlick's F at
+        // n_c.v, which weights the lobe and attenuates the base beneath.
+        t.coat = true;
+        t.coat_NoL = glm::clamp(glm::dot(in.clearcoat_n, in.l), 0.0f, 1.0f);
+        t.coat_NoV = glm::clamp(glm::dot(in.clearcoat_n, in.v), 0.0f, 1.0f);
+        t.coat_NoH = glm::clamp(glm::dot(in.clearcoat_n, h), 0.0f, 1.0f);
+        const float rc = glm::clamp(in.clearcoat_roughness, kMinPerceptualRoughness, 1.0f);
+        const float ac = rc * rc;
+        t.coat_F = F_Schlick(kClearcoatF0, t.coat_NoV);
+        t.coat_D = D_GGX(t.coat_NoH, ac);
+        float lobe;
+        if (model == BrdfModel::Gltf) {
+            t.coat_G = V_SmithGGXCorrelated(t.coat_NoV, t.coat_NoL, ac);
+            lobe = t.coat_D * t.coat_G;
+        } else {
+            t.coat_G = G_Smith(t.coat_NoV, t.coat_NoL, in.ibl_geometry ? k_ibl(rc) : k_direct(rc));
+            lobe = t.coat_D * t.coat_G /
+                   (4.0f * std::max(t.coat_NoV, kBrdfMinCos) * std::max(t.coat_NoL, kBrdfMinCos));
+        }
+        t.coat_attenuation = 1.0f - in.clearcoat * t.coat_F;
+        t.coat_specular = in.clearcoat * t.coat_F * lobe;
+        t.diffuse = t.diffuse * t.coat_attenuation;
+        t.specular = t.specular * t.coat_attenuation;
+        t.f = t.diffuse + t.specular;
+        if (t.sheen) {  // the sheen lies under the coat too
+            t.sheen_f = t.sheen_f * t.coat_attenuation;
+            t.f = t.f + t.sheen_f;
+        }
+    }
     return t;
+}
+
+// One light's reflected radiance from its terms: f radiance n.l, plus the
+// clear coat's lobe times radiance n_c.l.
+inline glm::vec3 brdf_light(const BrdfTerms& t, const glm::vec3& radiance) {
+    glm::vec3 c = t.f * radiance * t.NoL;
+    if (t.coat) c += glm::vec3(t.coat_specular) * radiance * t.coat_NoL;
+    return c;
 }
 
 } // namespace prast

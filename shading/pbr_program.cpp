@@ -31,12 +31,14 @@ glm::vec3 sum_lobes(const MaterialSample& ms, const SurfacePoint& sp, const Shad
         radiance *= light_visibility(L, sp.P, ms.N_geom);
         BrdfTerms t = evaluate_brdf(bi, ctx.model);
         sum += (specular ? t.specular : t.diffuse) * radiance * t.NoL;
+        if (specular && t.coat) sum += glm::vec3(t.coat_specular) * radiance * t.coat_NoL;  // the clear coat's lobe
     }
     // The split sum's lobe of the environment (not in reference mode: the
     // integral does not split into lobes).
     if (ctx.env && ctx.ibl == IblMode::SplitSum) {
         const IblTerms t = ibl_terms(ms, sp, ctx);
         sum += specular ? t.specular : t.diffuse;
+        if (specular && t.coat) sum += t.coat_specular;
     }
     return sum;
 }
@@ -297,8 +299,10 @@ void PbrProgramT<NV>::shade_packed(const FragmentBlock<kVaryings>* const* in, Fr
 template <int NV>
 bool PbrProgramT<NV>::lit_lanes() const {
     const bool reference = ctx->env && ctx->ibl == IblMode::Reference;
+    // Layered materials (KHR_materials_specular, _clearcoat) shade lane by
+    // lane with the scalar code, as conductors do.
     return (view == DebugView::None || view == DebugView::Tiles) && material->m->conductor == Conductor::None &&
-           !reference;
+           !material->m->layered() && !reference;
 }
 
 template <int NV>
@@ -330,8 +334,8 @@ template <int NV>
 void PbrProgramT<NV>::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& out) const {
     const Material& m = *material->m;
     // The lit path samples the material and lights the lanes together, packed
-    // when few are live; debug views, conductor materials and the reference
-    // integral of the environment go lane by lane.
+    // when few are live; debug views, conductor and layered materials and the
+    // reference integral of the environment go lane by lane.
     if (lit_lanes()) {
         if (__builtin_popcount(in.mask) > 8) {
             shade_block(in, out);

@@ -71,8 +71,24 @@ struct BoundMaterial {
     std::uint8_t transformed = 0;
     UvTransform xf[kMaps] = {};
     const UvTransform* transform_of(int map) const { return (transformed >> map) & 1u ? &xf[map] : nullptr; }
+    // The maps of KHR_materials_specular and KHR_materials_clearcoat, each
+    // with its UV set and transform. Only the scalar path reads them: a
+    // layered material does not take the lanes (PbrProgram::lit_lanes()).
+    enum ExtMap {
+        kSpecular, kSpecularColor, kClearcoat, kClearcoatRoughness, kClearcoatNormal, kSheenColor, kSheenRoughness,
+        kExtMaps
+    };
+    const Texture* ext[kExtMaps] = {};
+    std::uint8_t ext_uv[kExtMaps] = {};
+    std::uint8_t ext_transformed = 0;
+    UvTransform ext_xf[kExtMaps] = {};
+    const UvTransform* ext_transform_of(int map) const {
+        return (ext_transformed >> map) & 1u ? &ext_xf[map] : nullptr;
+    }
     // True when a bound map reads a UV set other than TEXCOORD_0.
     bool reads_extra_uv_sets() const {
+        for (int i = 0; i < kExtMaps; ++i)
+            if (ext[i] && ext_uv[i]) return true;
         return (base_color && uv.base_color) || (metallic_roughness && uv.metallic_roughness) ||
                (roughness && uv.roughness) || (metallic && uv.metallic) || (normal && uv.normal) ||
                (occlusion && uv.occlusion) || (emissive && uv.emissive);
@@ -112,6 +128,18 @@ struct MaterialSample {
     glm::vec3 N{0.0f, 0.0f, 1.0f};  // shading normal (normal-mapped, unit, facing flipped)
     glm::vec3 N_geom{0.0f, 0.0f, 1.0f}; // unit interpolated normal (facing flipped)
     bool unlit = false;  // KHR_materials_unlit: shade_surface() gives the albedo (base colour term)
+    // KHR_materials_specular (when has_specular): factor x texture A, colour x texture RGB.
+    bool has_specular = false;
+    float specular = 1.0f;
+    glm::vec3 specular_color{1.0f};
+    // KHR_materials_clearcoat: the coat's weight (0: none), its perceptual
+    // roughness and its normal (the geometric one without its own map).
+    float clearcoat = 0.0f;
+    float clearcoat_roughness = 0.0f;
+    glm::vec3 clearcoat_N{0.0f, 0.0f, 1.0f};
+    // KHR_materials_sheen: colour (0: none) and perceptual roughness.
+    glm::vec3 sheen_color{0.0f};
+    float sheen_roughness = 0.0f;
 };
 
 struct ShadingLight {
@@ -213,7 +241,11 @@ inline float light_visibility(const ShadingLight& L, const glm::vec3& P, const g
 struct MaterialLods {
     float base_color = 0, metallic_roughness = 0, roughness = 0, metallic = 0;
     float normal = 0, occlusion = 0, emissive = 0;
+    float ext[BoundMaterial::kExtMaps] = {};  // BoundMaterial::ext's maps
 };
+
+// The extension maps' levels, each from its UV set through its transform.
+inline void extension_lods(const BoundMaterial& bm, const SurfacePoint& sp, MaterialLods& l);
 
 // Every map with the derivatives of UV set 0.
 inline MaterialLods material_lods(const BoundMaterial& bm, glm::vec2 duv_dx, glm::vec2 duv_dy) {
@@ -232,8 +264,13 @@ inline MaterialLods material_lods(const BoundMaterial& bm, glm::vec2 duv_dx, glm
 // Each map with the derivatives of the UV set it reads, through its
 // transform's linear part when it has one.
 inline MaterialLods material_lods(const BoundMaterial& bm, const SurfacePoint& sp) {
-    if (!bm.reads_extra_uv_sets() && !bm.transformed) return material_lods(bm, sp.duv_dx, sp.duv_dy);
+    if (!bm.reads_extra_uv_sets() && !bm.transformed) {
+        MaterialLods l = material_lods(bm, sp.duv_dx, sp.duv_dy);
+        if (bm.m && bm.m->layered()) extension_lods(bm, sp, l);
+        return l;
+    }
     MaterialLods l;
+    if (bm.m && bm.m->layered()) extension_lods(bm, sp, l);
     auto lod = [&](const Texture* t, int set, int map) {
         if (!t) return 0.0f;
         glm::vec2 dx = sp.duv_dx_of(set), dy = sp.duv_dy_of(set);
@@ -254,6 +291,18 @@ inline MaterialLods material_lods(const BoundMaterial& bm, const SurfacePoint& s
     return l;
 }
 
+inline void extension_lods(const BoundMaterial& bm, const SurfacePoint& sp, MaterialLods& l) {
+    for (int i = 0; i < BoundMaterial::kExtMaps; ++i) {
+        if (!bm.ext[i]) continue;
+        glm::vec2 dx = sp.duv_dx_of(bm.ext_uv[i]), dy = sp.duv_dy_of(bm.ext_uv[i]);
+        if (const UvTransform* x = bm.ext_transform_of(i)) {
+            dx = x->linear(dx);
+            dy = x->linear(dy);
+        }
+        l.ext[i] = bm.ext[i]->lod(dx.x, dx.y, dy.x, dy.y);
+    }
+}
+
 
 namespace surface_detail {
 
@@ -269,6 +318,29 @@ inline glm::vec4 fetch(const BoundMaterial& bm, int map, const Texture* tex, con
     glm::vec2 uv = sp.uv_of(set);
     if (const UvTransform* x = bm.transform_of(map)) uv = x->apply(uv);
     return tex->sample_lod(uv.x, uv.y, lambda);
+}
+
+// An extension map (BoundMaterial::ExtMap) at its UV set, through its transform.
+inline glm::vec4 fetch_ext(const BoundMaterial& bm, int map, const SurfacePoint& sp, const MaterialLods& lods) {
+    glm::vec2 uv = sp.uv_of(bm.ext_uv[map]);
+    if (const UvTransform* x = bm.ext_transform_of(map)) uv = x->apply(uv);
+    return bm.ext[map]->sample_lod(uv.x, uv.y, lods.ext[map]);
+}
+
+// A tangent-space normal map's texel turned into a world normal about the
+// unit N (T from the tangent, re-orthogonalised); `fallback` without a frame.
+inline glm::vec3 map_normal(const glm::vec3& N, const glm::vec4& tangent, const glm::vec4& tx, float scale,
+                            const glm::vec3& fallback) {
+    glm::vec3 T = glm::vec3(tangent);
+    T = safe_normalize(T - N * glm::dot(N, T), glm::vec3(0.0f));
+    if (!(glm::dot(T, T) > 0.0f)) return fallback;
+    const float w = tangent.w < 0.0f ? -1.0f : 1.0f;
+    const glm::vec3 B = glm::cross(N, T) * w;
+    glm::vec3 nt = glm::vec3(tx) * 2.0f - 1.0f;
+    nt.x *= scale;
+    nt.y *= scale;
+    nt = safe_normalize(nt, glm::vec3(0.0f, 0.0f, 1.0f));
+    return safe_normalize(T * nt.x + B * nt.y + N * nt.z, N);
 }
 
 } // namespace surface_detail
@@ -294,6 +366,48 @@ inline glm::vec3 facing_normal(const glm::vec3& n, const glm::vec3& v) {
     const float bx = n.x + v.x * k, by = n.y + v.y * k, bz = n.z + v.z * k;
     const float len = std::sqrt(bx * bx + by * by + bz * bz);
     return glm::vec3(bx / len, by / len, bz / len);
+}
+
+// The KHR_materials_specular, _clearcoat and _sheen parameters at a point:
+// factors times their maps (specular A, colour RGB; clearcoat R, its
+// roughness G; sheen colour RGB, roughness A; each clamped to [0, 1]), and the coat's normal from its own map about the
+// unit interpolated normal N (the geometric normal without one).
+inline void sample_layers(const BoundMaterial& bm, const SurfacePoint& sp, const MaterialLods& lods,
+                          const glm::vec3& N, float flip, MaterialSample& s) {
+    const Material& m = *bm.m;
+    using B = BoundMaterial;
+    if (m.has_specular) {
+        s.has_specular = true;
+        s.specular = m.specular_factor;
+        s.specular_color = m.specular_color_factor;
+        if (bm.ext[B::kSpecular]) s.specular *= surface_detail::fetch_ext(bm, B::kSpecular, sp, lods).a;
+        if (bm.ext[B::kSpecularColor])
+            s.specular_color *= glm::vec3(surface_detail::fetch_ext(bm, B::kSpecularColor, sp, lods));
+        s.specular = glm::clamp(s.specular, 0.0f, 1.0f);
+    }
+    if (m.has_clearcoat) {
+        s.clearcoat = m.clearcoat_factor;
+        s.clearcoat_roughness = m.clearcoat_roughness_factor;
+        if (bm.ext[B::kClearcoat]) s.clearcoat *= surface_detail::fetch_ext(bm, B::kClearcoat, sp, lods).r;
+        if (bm.ext[B::kClearcoatRoughness])
+            s.clearcoat_roughness *= surface_detail::fetch_ext(bm, B::kClearcoatRoughness, sp, lods).g;
+        s.clearcoat = glm::clamp(s.clearcoat, 0.0f, 1.0f);
+        s.clearcoat_roughness = glm::clamp(s.clearcoat_roughness, 0.0f, 1.0f);
+        s.clearcoat_N = s.N_geom;
+        if (bm.ext[B::kClearcoatNormal]) {
+            const glm::vec4 tx = surface_detail::fetch_ext(bm, B::kClearcoatNormal, sp, lods);
+            s.clearcoat_N = surface_detail::map_normal(N, sp.T, tx, m.clearcoat_normal_scale, N) * flip;
+        }
+    }
+    if (m.has_sheen) {
+        s.sheen_color = m.sheen_color_factor;
+        s.sheen_roughness = m.sheen_roughness_factor;
+        if (bm.ext[B::kSheenColor]) s.sheen_color *= glm::vec3(surface_detail::fetch_ext(bm, B::kSheenColor, sp, lods));
+        if (bm.ext[B::kSheenRoughness])
+            s.sheen_roughness *= surface_detail::fetch_ext(bm, B::kSheenRoughness, sp, lods).a;
+        s.sheen_color = glm::clamp(s.sheen_color, glm::vec3(0.0f), glm::vec3(1.0f));
+        s.sheen_roughness = glm::clamp(s.sheen_roughness, 0.0f, 1.0f);
+    }
 }
 
 inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoint& sp, const MaterialLods& lods) {
@@ -355,6 +469,7 @@ inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoin
             s.N = surface_detail::safe_normalize(n, N) * flip;
         }
     }
+    if (m.layered()) sample_layers(bm, sp, lods, N, flip, s);
     return s;
 }
 
@@ -366,11 +481,13 @@ inline void apply_energy_terms(BrdfInputs& in, const DfgTable& table) {
     const float r = glm::clamp(in.roughness, kMinPerceptualRoughness, 1.0f);
     const glm::vec4 ab = table.lookup(NoV, r);
     const glm::vec3 F0 = brdf_f0(in);
+    const float F90 = brdf_f90(in);
     const float metal = in.conductor != Conductor::None ? 1.0f : in.metallic;
     in.energy = true;
     for (int c = 0; c < 3; ++c) {
         const float comp = energy_compensation(F0[c], ab.x, ab.y);
-        const float E = (F0[c] * ab.x + ab.y) * comp;
+        // KHR_materials_specular: E_spec = (F0 A + F90 B) comp.
+        const float E = (F0[c] * ab.x + (in.specular_ext ? F90 * ab.y : ab.y)) * comp;
         in.energy_comp[c] = comp;
         in.energy_kd[c] = (1.0f - E) * (1.0f - metal);
     }
@@ -389,7 +506,27 @@ inline BrdfInputs plain_brdf_inputs(const MaterialSample& ms, const SurfacePoint
     in.roughness = ms.roughness;
     in.ior = ms.ior;
     in.conductor = ms.conductor;
+    if (ms.has_specular) {
+        in.specular_ext = true;
+        in.specular = ms.specular;
+        in.specular_color = ms.specular_color;
+    }
+    if (ms.clearcoat > 0.0f) {
+        in.clearcoat = ms.clearcoat;
+        in.clearcoat_roughness = ms.clearcoat_roughness;
+        in.clearcoat_n = facing_normal(ms.clearcoat_N, in.v);
+    }
+    in.sheen_color = ms.sheen_color;
+    in.sheen_roughness = ms.sheen_roughness;
     return in;
+}
+
+// The emission under a clear coat: times 1 - clearcoat F_coat(n_c.v), the
+// coat's Fresnel at the view, as KHR_materials_clearcoat darkens it.
+inline glm::vec3 coated_emission(const MaterialSample& ms, const BrdfInputs& in) {
+    if (!(in.clearcoat > 0.0f)) return ms.emissive;
+    const float NoV = glm::clamp(glm::dot(in.clearcoat_n, in.v), 0.0f, 1.0f);
+    return ms.emissive * (1.0f - in.clearcoat * F_Schlick(kClearcoatF0, NoV));
 }
 
 inline BrdfInputs brdf_inputs(const MaterialSample& ms, const SurfacePoint& sp, const ShadingContext& ctx) {
@@ -418,7 +555,31 @@ struct IblTerms {
     glm::vec3 kd{0.0f};
     float occlusion = 1.0f;
     glm::vec3 diffuse{0.0f}, specular{0.0f};  // the two contributions to Lo
+    float F90 = 1.0f;              // KHR_materials_specular's (1 without it)
+    // KHR_materials_clearcoat (coat): the coat's split sum, clearcoat F_coat
+    // (A_c + B_c) prefiltered(R_c, level_c) occlusion, about its normal with
+    // its roughness; diffuse and specular above are already times
+    // attenuation = 1 - clearcoat F_coat, F_coat = F_Schlick(0.04, n_c.v).
+    bool coat = false;
+    glm::vec3 coat_N{0.0f}, coat_R{0.0f}, coat_prefiltered{0.0f};
+    float coat_level = 0.0f, coat_NoV = 0.0f, coat_F = 0.0f, coat_dfg_scale = 0.0f, coat_dfg_bias = 0.0f;
+    float coat_attenuation = 1.0f;
+    glm::vec3 coat_specular{0.0f};
+    // KHR_materials_sheen (sheen): colour E(n.v, r_s) (E(n)/pi) occlusion;
+    // diffuse and specular above are times scaling = 1 - max(colour) E(n.v)
+    // (and all three times the coat's attenuation).
+    bool sheen = false;
+    float sheen_E = 0.0f, sheen_scaling = 1.0f;
+    glm::vec3 sheen_irradiance{0.0f}, sheen_specular{0.0f};
 };
+
+// What the environment adds to Lo: diffuse + specular (+ the coat's lobe).
+inline glm::vec3 ibl_sum(const IblTerms& t) {
+    if (t.sheen && t.coat) return t.diffuse + t.specular + t.sheen_specular + t.coat_specular;
+    if (t.sheen) return t.diffuse + t.specular + t.sheen_specular;
+    if (t.coat) return t.diffuse + t.specular + t.coat_specular;
+    return t.diffuse + t.specular;
+}
 
 // ctx.env and ctx.dfg_ibl must be set. The lane code (light_block.h) performs
 // the same float operations in the same order.
@@ -455,20 +616,81 @@ inline IblTerms ibl_terms(const MaterialSample& ms, const SurfacePoint& sp, cons
     in.conductor = ms.conductor;
     const glm::vec3 F0 = brdf_f0(in);
     const float metal = ms.conductor != Conductor::None ? 1.0f : ms.metallic;
-    for (int c = 0; c < 3; ++c) {
-        if (ctx.energy) {
-            t.energy_comp[c] = energy_compensation(F0[c], dfg.x, dfg.y);
-            t.specular_albedo[c] = (F0[c] * dfg.x + dfg.y) * t.energy_comp[c];
-            t.kd[c] = (1.0f - t.specular_albedo[c]) * (1.0f - metal);
-        } else {
-            t.specular_albedo[c] = F0[c] * dfg.x + dfg.y;
-            t.kd[c] = (1.0f - F0[c]) * dfg.z * (1.0f - metal);
+    if (ms.has_specular) {
+        // KHR_materials_specular: E_spec = F0 A + F90 B, and the diffuse's
+        // cosine-weighted 1 - F = 1 - F0 - (F90 - F0)(1 - Kd) (dfg.h: the
+        // lobe's mean of (1 - v.h)^5 is 1 - Kd).
+        in.specular_ext = true;
+        in.specular = ms.specular;
+        in.specular_color = ms.specular_color;
+        const glm::vec3 F0s = brdf_f0(in);
+        t.F90 = brdf_f90(in);
+        for (int c = 0; c < 3; ++c) {
+            if (ctx.energy) {
+                t.energy_comp[c] = energy_compensation(F0s[c], dfg.x, dfg.y);
+                t.specular_albedo[c] = (F0s[c] * dfg.x + t.F90 * dfg.y) * t.energy_comp[c];
+                t.kd[c] = (1.0f - t.specular_albedo[c]) * (1.0f - metal);
+            } else {
+                t.specular_albedo[c] = F0s[c] * dfg.x + t.F90 * dfg.y;
+                t.kd[c] = (1.0f - F0s[c] - (t.F90 - F0s[c]) * (1.0f - dfg.z)) * (1.0f - metal);
+            }
+        }
+    } else {
+        for (int c = 0; c < 3; ++c) {
+            if (ctx.energy) {
+                t.energy_comp[c] = energy_compensation(F0[c], dfg.x, dfg.y);
+                t.specular_albedo[c] = (F0[c] * dfg.x + dfg.y) * t.energy_comp[c];
+                t.kd[c] = (1.0f - t.specular_albedo[c]) * (1.0f - metal);
+            } else {
+                t.specular_albedo[c] = F0[c] * dfg.x + dfg.y;
+                t.kd[c] = (1.0f - F0[c]) * dfg.z * (1.0f - metal);
+            }
         }
     }
     t.irradiance = env.irradiance(n);
     t.occlusion = ms.occlusion;
     t.diffuse = t.kd * ms.albedo * t.irradiance * ms.occlusion;
     t.specular = t.specular_albedo * t.prefiltered * ms.occlusion;
+    if (ms.sheen_color.x > 0.0f || ms.sheen_color.y > 0.0f || ms.sheen_color.z > 0.0f) {
+        // The sheen's split sum: its albedo E(n.v) times the irradiance
+        // E(n)/pi: the Charlie lobe is broad and grazing, and against the
+        // reference this measured better than the prefiltered map along the
+        // mirror direction (Filament's choice): mean error 7% for 10%.
+        t.sheen = true;
+        const float rs = glm::clamp(ms.sheen_roughness, kMinPerceptualRoughness, 1.0f);
+        t.sheen_E = sheen_albedo(t.NoV, rs);
+        const float cmax = std::max(ms.sheen_color.x, std::max(ms.sheen_color.y, ms.sheen_color.z));
+        t.sheen_scaling = 1.0f - cmax * t.sheen_E;
+        t.sheen_irradiance = env.irradiance(n);
+        t.diffuse = t.diffuse * t.sheen_scaling;
+        t.specular = t.specular * t.sheen_scaling;
+        t.sheen_specular = ms.sheen_color * t.sheen_E * t.sheen_irradiance * ms.occlusion;
+    }
+    if (ms.clearcoat > 0.0f) {
+        // The coat's own split sum: its lobe is F_coat D G (Fresnel at n_c.v,
+        // outside the integral), so its albedo is F_coat (A + B) at (n_c.v, r_c).
+        t.coat = true;
+        const glm::vec3 nc = facing_normal(ms.clearcoat_N, v);
+        t.coat_N = nc;
+        const float dc = glm::dot(nc, v);
+        t.coat_NoV = glm::clamp(dc, kMinNoV, 1.0f);
+        const float rc = glm::clamp(ms.clearcoat_roughness, kMinPerceptualRoughness, 1.0f);
+        const glm::vec3 Rc = nc * (2.0f * dc) - v;
+        const float fc = (rc * rc) * (rc * rc);
+        t.coat_R = Rc * (1.0f - fc) + nc * fc;
+        t.coat_level = Environment::roughness_lod(rc);
+        t.coat_prefiltered = env.prefiltered(t.coat_R, t.coat_level);
+        t.coat_level = glm::clamp(t.coat_level, 0.0f, float(Environment::kSpecularLevels - 1));
+        const glm::vec4 cd = ctx.dfg_ibl->lookup(t.coat_NoV, rc);
+        t.coat_dfg_scale = cd.x;
+        t.coat_dfg_bias = cd.y;
+        t.coat_F = F_Schlick(kClearcoatF0, glm::clamp(dc, 0.0f, 1.0f));
+        t.coat_attenuation = 1.0f - ms.clearcoat * t.coat_F;
+        t.diffuse = t.diffuse * t.coat_attenuation;
+        t.specular = t.specular * t.coat_attenuation;
+        t.sheen_specular = t.sheen_specular * t.coat_attenuation;
+        t.coat_specular = t.coat_prefiltered * (ms.clearcoat * t.coat_F * (cd.x + cd.y)) * ms.occlusion;
+    }
     return t;
 }
 
@@ -486,13 +708,13 @@ inline glm::vec3 shade_surface(const MaterialSample& ms, const SurfacePoint& sp,
     if (terms) terms->clear();
     if (ms.unlit) return ms.albedo;  // KHR_materials_unlit: no light, environment or emissive
     BrdfInputs in = brdf_inputs(ms, sp, ctx);
-    glm::vec3 Lo = ms.emissive;
+    glm::vec3 Lo = coated_emission(ms, in);
     for (const ShadingLight& L : ctx.lights) {
         glm::vec3 radiance;
         light_at(L, sp.P, in.l, radiance);
         radiance *= light_visibility(L, sp.P, ms.N_geom);
         BrdfTerms t = evaluate_brdf(in, ctx.model);
-        Lo += t.f * radiance * t.NoL;
+        Lo += brdf_light(t, radiance);
         if (terms) terms->push_back(t);
     }
     if (!ctx.env) {
@@ -501,7 +723,7 @@ inline glm::vec3 shade_surface(const MaterialSample& ms, const SurfacePoint& sp,
         Lo += ibl_reference(ms, sp, ctx, ctx.ibl_samples);
     } else {
         const IblTerms t = ibl_terms(ms, sp, ctx);
-        Lo += t.diffuse + t.specular;
+        Lo += ibl_sum(t);
     }
     return Lo;
 }

@@ -535,11 +535,14 @@ glm::vec3 resolve_average(const glm::vec3* colors, int samples) {
     return out;
 }
 
-PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x, int y) {
+PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x, int y, std::uint64_t upto,
+                               const Framebuffer* frame) {
     PixelExplanation px;
     px.x = x;
     px.y = y;
     px.samples = rec.samples;
+    px.upto = upto >= rec.triangle_count() ? kAllTriangles : upto;
+    const bool all = px.upto == kAllTriangles;
     const int S = rec.samples;
     const ShadingContext ctx = s.shading_context();
     const TileRecord& tile = rec.tiles[std::size_t(rec.tile_of(x, y))];
@@ -636,15 +639,18 @@ PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x,
     std::size_t next_draw = 0;  // line draws before it are done
     auto lines_before = [&](std::size_t di) {
         for (; next_draw < di && next_draw < rec.draws.size(); ++next_draw)
-            if (rec.draws[next_draw].topology != Topology::Triangles) line_draw(next_draw);
+            if (rec.draws[next_draw].topology != Topology::Triangles &&
+                (all || rec.draws[next_draw].first_triangle < px.upto))  // SceneRenderer's limit
+                line_draw(next_draw);
     };
     for (const BlockRecord& b : tile.blocks) {
         if (b.bx != bx || b.by != by || !(b.mask & (1u << lane))) continue;
+        const std::uint32_t tri = rec.pieces[b.piece].triangle;
+        if (tri >= px.upto) continue;
         HistoryEntry h;
         h.piece = b.piece;
         h.lane = lane;
         h.block = &b;
-        const std::uint32_t tri = rec.pieces[b.piece].triangle;
         const DrawRecord& d = rec.draw_of(tri);
         lines_before(rec.draw_index(tri));
         h.visible = d.visible;
@@ -666,7 +672,19 @@ PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x,
     // The visibility pass's winners, shaded once per pixel: their colour.
     for (int i = 0; i < S; ++i) {
         if (pending[i] < 0) continue;
-        const HistoryEntry& w = px.history[std::size_t(pending[i])];
+        HistoryEntry& w = px.history[std::size_t(pending[i])];
+        if (!all && !w.shaded) {
+            // A winner at this point that a later triangle beat by the
+            // frame's end: shaded here as draw_upto's frame shades it (the
+            // lane among those the shader runs for, which decides its centroid).
+            BlockRecord b = *w.block;
+            b.shaded = std::uint16_t(b.shaded | (1u << lane));
+            replay_block(s, rec, b, w.replay);
+            w.shading = shade_lane(ctx, material_of(s, rec, rec.pieces[b.piece].triangle), w.replay, lane);
+            w.shaded = true;
+            w.killed = w.shading.killed;
+            w.written = !w.killed;
+        }
         px.sample_owner[i] = pending[i];
         px.sample_color[i] = w.written ? w.shading.Lo : glm::vec3(0.0f);
     }
@@ -680,7 +698,7 @@ PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x,
 
     // The resolve (the samples' average), then docs/conventions.md "Output".
     px.linear = resolve_average(px.sample_color, S);
-    px.framebuffer = color_of(rec.fb, x, y);
+    px.framebuffer = all || !frame ? color_of(rec.fb, x, y) : color_of(*frame, x, y);
     px.exposed = px.linear * s.exposure();
     px.toned = tonemap(px.exposed, s.tonemap());
     const float rgba[4] = {px.linear.r, px.linear.g, px.linear.b, 1.0f};
@@ -763,6 +781,17 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
     map("metallic", bm.metallic, bm.uv.metallic, sh.lods.metallic);
     map("occlusion", bm.occlusion, bm.uv.occlusion, sh.lods.occlusion);
     map("emissive", bm.emissive, bm.uv.emissive, sh.lods.emissive);
+    {
+        static const char* const kExtNames[BoundMaterial::kExtMaps] = {
+            "specularTexture", "specularColorTexture", "clearcoatTexture", "clearcoatRoughnessTexture",
+            "clearcoatNormalTexture", "sheenColorTexture", "sheenRoughnessTexture"};
+        for (int i = 0; i < BoundMaterial::kExtMaps; ++i) {
+            if (!bm.ext[i]) continue;
+            glm::vec2 uv = sp.uv_of(bm.ext_uv[i]);
+            if (const UvTransform* x = bm.ext_transform_of(i)) uv = x->apply(uv);
+            o << map_text(kExtNames[i], bm.ext[i], bm.ext_uv[i], uv, sh.lods.ext[i], "  ");
+        }
+    }
     if (bm.base_color || sp.has_color) {
         const glm::vec2 buv = sp.uv_of(bm.uv.base_color);
         const glm::vec4 tex = bm.base_color ? bm.base_color->sample_lod(buv.x, buv.y, sh.lods.base_color) : glm::vec4(1.0f);
@@ -776,9 +805,29 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
     if (ms.conductor != Conductor::None) {
         const ConductorIOR c = conductor_ior(ms.conductor);
         o << "  conductor " << conductor_name(ms.conductor) << ": eta " << vec(c.eta) << " k " << vec(c.k) << "\n";
+    } else if (ms.has_specular) {
+        o << "  KHR_materials_specular: specular " << num(ms.specular) << ", colour " << vec(ms.specular_color)
+          << "; F0 = mix(min(F0(ior " << num(ms.ior) << ") " << num(f0_from_ior(ms.ior))
+          << " x colour, 1) x specular, albedo, metallic) = " << vec(brdf_f0(sh.inputs))
+          << ", F90 = mix(specular, 1, metallic) = " << num(brdf_f90(sh.inputs)) << "\n";
     } else {
         o << "  F0 " << vec(glm::mix(glm::vec3(f0_from_ior(ms.ior)), ms.albedo, ms.metallic)) << " (ior "
           << num(ms.ior) << ")\n";
+    }
+    if (sh.inputs.clearcoat > 0.0f) {
+        const float rc = glm::clamp(ms.clearcoat_roughness, kMinPerceptualRoughness, 1.0f);
+        o << "  KHR_materials_clearcoat: clearcoat " << num(ms.clearcoat) << ", roughness "
+          << num(ms.clearcoat_roughness) << " (clamped " << num(rc) << ", alpha " << num(rc * rc)
+          << "), coat normal n_c " << vec(sh.inputs.clearcoat_n)
+          << (bm.ext[BoundMaterial::kClearcoatNormal] ? " (its own normal map, scale " + num(m.clearcoat_normal_scale) + ")"
+                                                       : std::string(" (the geometric normal)"))
+          << ", F0 0.04\n";
+    }
+    if (sh.inputs.has_sheen()) {
+        const float rs = glm::clamp(ms.sheen_roughness, kMinPerceptualRoughness, 1.0f);
+        o << "  KHR_materials_sheen: colour " << vec(ms.sheen_color) << ", roughness " << num(ms.sheen_roughness)
+          << " (clamped " << num(rs) << ", alpha " << num(rs * rs) << "), Charlie D and V, albedo E(n.v) "
+          << num(sheen_albedo(glm::clamp(glm::dot(sh.inputs.n, sh.inputs.v), 0.0f, 1.0f), rs)) << "\n";
     }
     o << "  v " << vec(sh.inputs.v) << " (towards the eye " << vec(s.settings.camera.eye) << " from P " << vec(sp.P)
       << ")\n";
@@ -801,10 +850,28 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
           << "  v.h " << num(t.VoH) << "\n";
         o << "    D " << num(t.D) << "  " << (s.settings.model == BrdfModel::Gltf ? "V " : "G ") << num(t.G) << "  F "
           << vec(t.F) << "  kd " << vec(t.kd) << "\n";
-        o << "    diffuse " << vec(t.diffuse) << "  specular " << vec(t.specular) << "\n";
-        o << "    contribution (diffuse + specular) * radiance * n.l = " << vec(L.contribution) << "\n";
+        if (t.sheen)
+            o << "    sheen: D " << num(t.sheen_D) << "  V " << num(t.sheen_V) << " -> colour D V " << vec(t.sheen_f)
+              << (t.coat ? " (times the coat's attenuation)" : "") << "; the base beneath times min(1 - max(colour) "
+              << "E(n.v), 1 - max(colour) E(n.l)) = " << num(t.sheen_scaling) << "\n";
+        o << "    diffuse " << vec(t.diffuse) << "  specular " << vec(t.specular)
+          << (t.coat ? "  (both times the coat's 1 - clearcoat F_coat = " + num(t.coat_attenuation) + ")" : std::string())
+          << "\n";
+        if (t.coat) {
+            o << "    clear coat: n_c.l " << num(t.coat_NoL) << "  n_c.v " << num(t.coat_NoV) << "  n_c.h "
+              << num(t.coat_NoH) << "  D " << num(t.coat_D) << "  " << (s.settings.model == BrdfModel::Gltf ? "V " : "G ")
+              << num(t.coat_G) << "  F_coat(n_c.v) " << num(t.coat_F) << " -> coat lobe clearcoat F_coat D "
+              << (s.settings.model == BrdfModel::Gltf ? "V " : "G / (4 n_c.v n_c.l) ") << num(t.coat_specular) << "\n";
+            o << "    contribution (diffuse + specular) * radiance * n.l + coat * radiance * n_c.l = "
+              << vec(L.contribution) << "\n";
+        } else {
+            o << "    contribution (diffuse + specular) * radiance * n.l = " << vec(L.contribution) << "\n";
+        }
     }
-    o << "  emissive " << vec(ms.emissive) << "\n";
+    o << "  emissive " << vec(ms.emissive);
+    if (sh.inputs.clearcoat > 0.0f)
+        o << " x (1 - clearcoat F_coat(n_c.v)) = " << vec(coated_emission(ms, sh.inputs)) << " (under the coat)";
+    o << "\n";
     if (sh.ibl) {
         const IblTerms& t = sh.ibl_terms;
         o << "  environment (split sum): irradiance E(n)/pi " << vec(t.irradiance) << ", kd " << vec(t.kd)
@@ -812,7 +879,24 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
         o << "    prefiltered " << vec(t.prefiltered) << " along " << vec(t.R) << " at level " << num(t.level)
           << ", dfg scale " << num(t.dfg_scale) << " bias " << num(t.dfg_bias) << " (n.v " << num(t.NoV)
           << ") -> specular " << vec(t.specular) << "\n";
-        o << "    occlusion " << num(t.occlusion) << "; diffuse + specular = " << vec(sh.ambient) << "\n";
+        if (ms.has_specular) o << "    KHR_materials_specular: specular albedo F0 A + F90 B with F90 " << num(t.F90) << "\n";
+        if (t.sheen)
+            o << "    sheen: irradiance E(n)/pi " << vec(t.sheen_irradiance) << ", E(n.v) " << num(t.sheen_E)
+              << " -> colour E irradiance occlusion "
+              << vec(t.sheen_specular) << "; diffuse and specular above times 1 - max(colour) E = "
+              << num(t.sheen_scaling) << "\n";
+        if (t.coat) {
+            o << "    clear coat: prefiltered " << vec(t.coat_prefiltered) << " along " << vec(t.coat_R) << " at level "
+              << num(t.coat_level) << ", dfg scale " << num(t.coat_dfg_scale) << " bias " << num(t.coat_dfg_bias)
+              << " (n_c.v " << num(t.coat_NoV) << "), F_coat " << num(t.coat_F)
+              << " -> coat clearcoat F_coat (A + B) prefiltered occlusion " << vec(t.coat_specular)
+              << "; diffuse and specular above times 1 - clearcoat F_coat = " << num(t.coat_attenuation) << "\n";
+            o << "    occlusion " << num(t.occlusion) << "; diffuse + specular" << (t.sheen ? " + sheen" : "")
+              << " + coat = " << vec(sh.ambient) << "\n";
+        } else {
+            o << "    occlusion " << num(t.occlusion) << "; diffuse + specular" << (t.sheen ? " + sheen" : "") << " = "
+              << vec(sh.ambient) << "\n";
+        }
     } else {
         o << "  ambient " << vec(s.settings.ambient) << " * albedo * occlusion = " << vec(sh.ambient) << "\n";
     }
@@ -904,6 +988,11 @@ std::string pixel_text(const FrameSetup& s, const Recording& rec, const PixelExp
             o << " s" << i << " (" << num(pattern.pixel_x(i)) << ", " << num(pattern.pixel_y(i)) << ")";
         o << "\n";
     }
+    const bool partial = px.upto != kAllTriangles;
+    const std::string point = partial ? "after " + std::to_string(px.upto) + " triangles" : "after the frame";
+    if (partial)
+        o << "as the frame stands after the first " << px.upto << " of " << rec.triangle_count()
+          << " triangles (upto " << px.upto << "; `upto all` explains the frame's end)\n";
     o << "history: cleared to " << vec(px.background) << " depth 1, then " << px.history.size() << " fragment"
       << (px.history.size() == 1 ? "" : "s") << " in submission order\n";
     for (std::size_t i = 0; i < px.history.size(); ++i) {
@@ -976,7 +1065,7 @@ std::string pixel_text(const FrameSetup& s, const Recording& rec, const PixelExp
             o << "     NOTE: recomputed depth " << num(h.replay.in.z[l]) << "\n";
     }
     if (S > 1) {
-        o << "samples after the frame:\n";
+        o << "samples " << point << ":\n";
         for (int k = 0; k < S; ++k) {
             o << "  s" << k << " ";
             if (px.sample_owner[k] < 0) o << "cleared";
@@ -986,7 +1075,11 @@ std::string pixel_text(const FrameSetup& s, const Recording& rec, const PixelExp
         o << "resolve: the average of the " << S << " samples (summed pairwise) = " << vec(px.linear) << "\n";
     }
     if (px.contributors.empty()) {
-        o << "no fragment was written: the background " << vec(px.background) << "\n";
+        if (partial)
+            o << "no fragment was written in the first " << px.upto << " triangles: the pixel holds the clear colour "
+              << vec(px.background) << "\n";
+        else
+            o << "no fragment was written: the background " << vec(px.background) << "\n";
     } else {
         for (int k : px.contributors) {
             const HistoryEntry& w = px.history[std::size_t(k)];
@@ -997,7 +1090,8 @@ std::string pixel_text(const FrameSetup& s, const Recording& rec, const PixelExp
         }
     }
     if (std::memcmp(&px.framebuffer, &px.linear, sizeof px.linear))
-        o << "NOTE: the recorded frame holds " << vec(px.framebuffer) << "\n";
+        o << "NOTE: the " << (partial ? "frame " + point : std::string("recorded frame")) << " holds "
+          << vec(px.framebuffer) << "\n";
     o << "linear " << vec(px.linear) << "\n";
     o << "exposure " << num(s.exposure()) << " -> " << vec(px.exposed) << "\n";
     o << "tone map " << tonemap_name(s.tonemap()) << " -> " << vec(px.toned) << "\n";
@@ -1010,6 +1104,8 @@ json pixel_json(const FrameSetup& s, const Recording& rec, const PixelExplanatio
     j["x"] = px.x;
     j["y"] = px.y;
     j["samples"] = px.samples;
+    j["triangles"] = rec.triangle_count();
+    j["upto"] = px.upto == kAllTriangles ? json(nullptr) : json(px.upto);  // null: the frame's end
     j["background"] = j3(px.background);
     json hist = json::array();
     for (const HistoryEntry& h : px.history) {

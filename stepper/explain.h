@@ -59,6 +59,7 @@ struct HistoryEntry {
 struct PixelExplanation {
     int x = 0, y = 0, lane = 0;
     int samples = 1;
+    std::uint64_t upto = kAllTriangles;    // explained after the first `upto` triangles; kAllTriangles: the frame's end
     std::vector<HistoryEntry> history;
     int sample_owner[kMaxSamples];         // history index whose colour sample s holds; -1: cleared
     glm::vec3 sample_color[kMaxSamples];   // each sample's final linear colour
@@ -66,11 +67,17 @@ struct PixelExplanation {
     glm::vec3 background{0.0f};            // what every sample clears to: render's background here
     std::vector<int> contributors;         // history indices owning samples, most samples first
     glm::vec3 linear{0.0f};       // the resolve of the samples: what render --output .hdr writes
-    glm::vec3 framebuffer{0.0f};  // the recorded frame's value (equal to linear, or a NOTE says so)
+    glm::vec3 framebuffer{0.0f};  // the frame's value at that point (equal to linear, or a NOTE says so)
     glm::vec3 exposed{0.0f}, toned{0.0f};
     std::uint8_t srgb8[3] = {0, 0, 0};
 };
-PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x, int y);
+// Short of the frame's end (upto < the frame's triangles), the history holds
+// the fragments of the first `upto` triangles (and of the line and point
+// draws submitted before them), as draw_upto() draws them: the visibility
+// pass's winners at that point are shaded, and `frame` (draw_upto's frame)
+// gives the framebuffer's value; at or past the end, the recorded frame's.
+PixelExplanation explain_pixel(const FrameSetup& s, const Recording& rec, int x, int y,
+                               std::uint64_t upto = kAllTriangles, const Framebuffer* frame = nullptr);
 
 // The resolve of raster/resolve.cpp on one pixel: pairwise sums of the
 // samples' linear colours, times 1 / samples.

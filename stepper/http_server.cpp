@@ -193,7 +193,11 @@ int serve(Session& session, int port) {
         if (path == "/api/pixel") {
             const long x = int_param(req, "x", 0, rec.width - 1, "pixel column", image_is);
             const long y = int_param(req, "y", 0, rec.height - 1, "pixel row", image_is);
-            return json_response(pixel_json(s, rec, explain_pixel(s, rec, int(x), int(y))));
+            // The slider's point (`upto N`); without it, the frame's end.
+            std::uint64_t upto = kAllTriangles;
+            if (req.param_count("upto"))
+                upto = std::uint64_t(int_param(req, "upto", 0, long(rec.triangle_count()), "triangle count", frame_has));
+            return json_response(pixel_json(s, rec, session.explain(int(x), int(y), upto)));
         }
         if (path == "/api/tri") {
             const long n = int_param(req, "n", 0, long(rec.triangle_count()) - 1, "triangle number", frame_has);
@@ -247,6 +251,27 @@ int serve(Session& session, int port) {
                 if (!texture_png(s, rec, id, lv, png).empty()) throw BadRequest{500, "the texture cannot be drawn"};
                 return png;
             });
+        }
+        if (path == "/api/texel") {
+            // As /api/texture: the ID among the frame's, the level among its
+            // levels, then x and y inside that level.
+            TexturesView all;
+            if (!make_textures(s, rec, all).empty()) throw BadRequest{500, "the textures cannot be listed"};
+            if (req.param_count("id") != 1) throw BadRequest{400, "parameter 'id': one texture ID (see /api/textures)"};
+            const TextureInfo* info = nullptr;
+            for (const TextureInfo& t : all.textures)
+                if (t.id == req.param("id")) info = &t;
+            if (!info) throw BadRequest{404, "unknown texture ID (see /api/textures)"};
+            const long level = int_param(req, "level", 0, info->levels - 1, "mip level",
+                                         "the texture has " + std::to_string(info->levels) + " levels");
+            const glm::ivec2 size = info->level_sizes[std::size_t(level)];
+            const std::string has = "the level is " + std::to_string(size.x) + "x" + std::to_string(size.y);
+            const long x = int_param(req, "x", 0, size.x - 1, "texel column", has);
+            const long y = int_param(req, "y", 0, size.y - 1, "texel row", has);
+            TexelView v;
+            if (!make_texel(s, rec, info->id, std::to_string(level), std::to_string(x), std::to_string(y), v).empty())
+                throw BadRequest{500, "the texel cannot be shown"};
+            return json_response(v.json());
         }
         if (path == "/api/vertices") {
             const long d = int_param(req, "draw", 0, long(rec.draws.size()) - 1, "draw number", draws_are);

@@ -8,9 +8,11 @@
 //   GET /api/stages            [{name, title, about}]
 //   GET /api/stage?name=NAME   a stage image (PNG)
 //   GET /api/upto?n=N          the frame after the first N triangles (PNG)
-//   GET /api/pixel?x=X&y=Y     a pixel's history and breakdown (and the `pixel X Y` text)
+//   GET /api/pixel?x=X&y=Y[&upto=N]  a pixel's history and breakdown (and the `pixel X Y` text),
+//                              at the frame's end or after the first N triangles
 //   GET /api/tri?n=N           a triangle's setup (and the `tri N` text)
 //   GET /api/tile?x=TX&y=TY    a tile's bins (and the `tile TX TY` text)
+//   GET /api/texel?id=ID&level=L&x=X&y=Y  one texel's stored and linear values (`texel ID L X Y`)
 //   GET /favicon.ico           the tab's icon (drawn in code)
 #pragma once
 

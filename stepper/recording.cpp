@@ -321,7 +321,12 @@ void record_frame(FrameSetup& s, Recording& rec) {
 
 void draw_upto(FrameSetup& s, std::uint64_t triangles, Framebuffer& fb) {
     fb.resize(s.width(), s.height());
-    s.scene_renderer->render(s.settings, fb, nullptr, NoTaps{}, triangles);
+    std::uint64_t total = 0;
+    for (const Mesh& m : s.scene.meshes)
+        if (m.topology == Mesh::Topology::Triangles) total += m.indices.size() / 3;
+    // The renderer stops before the first draw past the limit: at the total,
+    // line and point draws after the last triangle would be left out.
+    s.scene_renderer->render(s.settings, fb, nullptr, NoTaps{}, triangles >= total ? kAllTriangles : triangles);
 }
 
 void draw_plain(FrameSetup& s, Framebuffer& fb) {

@@ -144,7 +144,12 @@ int draw_varyings(const FrameSetup& s, const SceneDraw& d);
 // Draws the frame (SceneRenderer::render, a recording tap on each draw); `rec` is filled.
 void record_frame(FrameSetup& s, Recording& rec);
 
-// The frame after the first `triangles` triangles (submission order).
+// No triangle limit: the whole frame.
+constexpr std::uint64_t kAllTriangles = ~std::uint64_t(0);
+
+// The frame after the first `triangles` triangles (submission order); all of
+// them (or more) is the whole frame, with the line and point draws after the
+// last triangle.
 void draw_upto(FrameSetup& s, std::uint64_t triangles, Framebuffer& fb);
 
 // The frame as `render` draws it (SceneRenderer, no observer): the cost

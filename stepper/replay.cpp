@@ -232,7 +232,7 @@ LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const
     // shade_surface(), one step at a time.
     r.inputs = brdf_inputs(r.ms, r.sp, ctx);
     BrdfInputs in = r.inputs;
-    glm::vec3 Lo = r.ms.emissive;
+    glm::vec3 Lo = coated_emission(r.ms, in);  // the emission, under the clear coat if any
     for (const ShadingLight& L : ctx.lights) {
         LightStep st;
         light_at(L, r.sp.P, in.l, st.radiance);
@@ -246,14 +246,14 @@ LaneShading shade_lane(const ShadingContext& ctx, const BoundMaterial& bm, const
         const float len2 = glm::dot(sum, sum);
         st.h = len2 > 0.0f ? sum / std::sqrt(len2) : in.n;
         st.terms = evaluate_brdf(in, ctx.model);
-        st.contribution = st.terms.f * st.radiance * st.terms.NoL;
+        st.contribution = brdf_light(st.terms, st.radiance);  // with the clear coat's lobe if any
         Lo += st.contribution;
         r.lights.push_back(st);
     }
     r.ibl = ctx.env != nullptr;
     if (r.ibl) {
         r.ibl_terms = ibl_terms(r.ms, r.sp, ctx);
-        r.ambient = r.ibl_terms.diffuse + r.ibl_terms.specular;
+        r.ambient = ibl_sum(r.ibl_terms);
     } else {
         r.ambient = ctx.ambient * r.ms.albedo * r.ms.occlusion;
     }

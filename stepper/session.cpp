@@ -225,9 +225,11 @@ Reply Session::help() const {
         "  textures             every texture ID (material maps, shadowL maps, env) with size, format, levels\n"
         "  texture ID [LEVEL [FILE]]  a texture's format and levels; writes the level (default 0) as a PNG\n"
         "                       (default texture-ID-level-L.png)\n"
-        "  json VIEW ...        the JSON of draws, draw, textures, texture, vertices or tile, on one line\n"
+        "  texel ID LEVEL X Y   one texel of that level (X, Y as in its PNG): stored and linear values\n"
+        "  json VIEW ...        the JSON of draws, draw, textures, texture, texel, vertices or tile, on one line\n"
         "  vertices N [FIRST [COUNT]]  draw N's vertices in and out of the vertex stage (16 from 0; at most 1000)\n"
-        "  upto N [FILE]        write the image after the first N triangles (default upto-N.png)\n"
+        "  upto N [FILE]        write the image after the first N triangles (default upto-N.png); pixel then\n"
+        "                       explains a pixel as it stands after them (upto all: at the frame's end again)\n"
         "  stage NAME [FILE]    write one stage image (default stage-NAME.png); NAME is one of:\n"
         "                      ";
     int col = 22;
@@ -277,17 +279,17 @@ Reply Session::run(const std::string& line) {
     }
     if (cmd == "json") {
         // The JSON the page's API serves for a view: one line.
-        static const char* kViews[] = {"draws", "draw", "textures", "texture", "vertices", "tile"};
+        static const char* kViews[] = {"draws", "draw", "textures", "texture", "texel", "vertices", "tile"};
         if (w.size() < 2 || std::find(std::begin(kViews), std::end(kViews), w[1]) == std::end(kViews))
-            return error("usage: json draws | draw N | textures | texture ID [LEVEL] | vertices N [FIRST [COUNT]] | "
-                         "tile X Y [FILTER]");
+            return error("usage: json draws | draw N | textures | texture ID [LEVEL] | texel ID LEVEL X Y | "
+                         "vertices N [FIRST [COUNT]] | tile X Y [FILTER]");
         if (w[1] == "texture" && w.size() > 4) return error("usage: json texture ID [LEVEL]");
         std::string rest;
         for (std::size_t i = 1; i < w.size(); ++i) rest += (i > 1 ? " " : "") + w[i];
         return run_view(rest, true);
     }
     if (cmd == "tile" || cmd == "draws" || cmd == "draw" || cmd == "textures" || cmd == "texture" ||
-        cmd == "vertices")
+        cmd == "texel" || cmd == "vertices")
         return run_view(line, false);
     return run_rest(w);
 }
@@ -341,6 +343,12 @@ Reply Session::run_view(const std::string& line, bool as_json) {
         return Reply{true, false,
                      v.text() + "texture " + w[1] + " " + std::to_string(v.level) + " -> wrote " + file + "\n"};
     }
+    if (cmd == "texel") {
+        if (!args(4, 4)) return error("usage: texel ID LEVEL X Y (textures lists the IDs, texture ID the levels)");
+        TexelView v;
+        const std::string e = make_texel(s_, rec_, w[1], w[2], w[3], w[4], v);
+        return e.empty() ? reply(v) : error(e);
+    }
     if (cmd == "vertices") {
         if (!args(1, 3)) return error("usage: vertices N [FIRST [COUNT]] (draw N; FIRST 0 and COUNT " +
                                       std::to_string(kDefaultVertexRows) + " by default)");
@@ -361,12 +369,18 @@ Reply Session::run_rest(const std::vector<std::string>& w) {
         if (!parse_int(w[1], 0, rec_.width - 1, a) || !parse_int(w[2], 0, rec_.height - 1, b))
             return error("pixel '" + w[1] + " " + w[2] + "': outside the " + std::to_string(rec_.width) + "x" +
                          std::to_string(rec_.height) + " image");
-        return Reply{true, false, pixel_text(s_, rec_, explain_pixel(s_, rec_, int(a), int(b)))};
+        return Reply{true, false, pixel_text(s_, rec_, explain(int(a), int(b), upto_))};
     }
     if (cmd == "upto") {
-        if (!args(1, 2)) return error("usage: upto N [FILE]");
+        if (!args(1, 2)) return error("usage: upto N [FILE] | upto all");
+        if (w[1] == "all") {
+            if (w.size() > 2) return error("upto all takes no file (upto N FILE writes one)");
+            upto_ = kAllTriangles;
+            return Reply{true, false, "upto all: pixel explains a pixel at the frame's end\n"};
+        }
         if (!parse_int(w[1], 0, long(rec_.triangle_count()), a))
-            return error("upto '" + w[1] + "': not a triangle count (0.." + std::to_string(rec_.triangle_count()) + ")");
+            return error("upto '" + w[1] + "': not a triangle count (0.." + std::to_string(rec_.triangle_count()) +
+                         ") or all");
         const std::string file = w.size() > 2 ? w[2] : "upto-" + std::to_string(a) + ".png";
         try {
             const std::vector<std::uint8_t> rgba = upto_rgba(std::uint64_t(a));
@@ -374,9 +388,14 @@ Reply Session::run_rest(const std::vector<std::string>& w) {
         } catch (const std::exception& e) {
             return error(e.what());
         }
+        // Errors above leave the point where it was.
+        upto_ = std::uint64_t(a) >= rec_.triangle_count() ? kAllTriangles : std::uint64_t(a);
+        const std::string now = upto_ == kAllTriangles ? "pixel X Y explains a pixel at the frame's end\n"
+                                                       : "pixel X Y now explains a pixel as it stands after these " +
+                                                             std::to_string(a) + " triangles (upto all: at the end)\n";
         return Reply{true, false, "upto " + std::to_string(a) + ": wrote " + file + " (the frame after the first " +
                                       std::to_string(a) + " of " + std::to_string(rec_.triangle_count()) +
-                                      " triangles)\n"};
+                                      " triangles)\n" + now};
     }
     if (cmd == "stage") {
         if (!args(1, 2)) return error("usage: stage NAME [FILE]");
@@ -411,9 +430,23 @@ std::vector<std::uint8_t> Session::stage_png(const std::string& name) {
     return encode_png(rec_.width, rec_.height, rgba.data());
 }
 
+const Framebuffer& Session::upto_frame(std::uint64_t triangles) {
+    if (triangles >= rec_.triangle_count()) return rec_.fb;
+    if (frame_upto_ != triangles) {
+        frame_upto_ = kAllTriangles;  // a throw below leaves no half-drawn frame named
+        draw_upto(s_, triangles, frame_);
+        frame_upto_ = triangles;
+    }
+    return frame_;
+}
+
+PixelExplanation Session::explain(int x, int y, std::uint64_t upto) {
+    if (upto >= rec_.triangle_count()) return explain_pixel(s_, rec_, x, y);
+    return explain_pixel(s_, rec_, x, y, upto, &upto_frame(upto));
+}
+
 std::vector<std::uint8_t> Session::upto_rgba(std::uint64_t triangles) {
-    Framebuffer fb;
-    draw_upto(s_, triangles, fb);
+    const Framebuffer& fb = upto_frame(triangles);
     std::vector<std::uint8_t> rgba(std::size_t(fb.width) * fb.height * 4);
     resolve_to_srgb8(fb.color.data(), fb.width, fb.height, s_.exposure(), s_.tonemap(), rgba.data());
     return rgba;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "stepper/explain.h"
 #include "stepper/recording.h"
 
 namespace prast::stepper {
@@ -28,6 +29,14 @@ public:
     std::vector<std::uint8_t> stage_png(const std::string& name);
     std::vector<std::uint8_t> upto_png(std::uint64_t triangles);
     std::vector<std::uint8_t> upto_rgba(std::uint64_t triangles);
+    // The frame after the first n triangles, kept until another n is asked
+    // for (the page's slider asks for its image, then for its pixels).
+    const Framebuffer& upto_frame(std::uint64_t triangles);
+    // Pixel X Y explained after the first `upto` triangles (kAllTriangles,
+    // or the frame's count or more: at the frame's end).
+    PixelExplanation explain(int x, int y, std::uint64_t upto);
+    // Where `pixel` explains: set by `upto N`, back to the end by `upto all`.
+    std::uint64_t upto() const { return upto_; }
 
     FrameSetup& scene() { return s_; }
     const Recording& recording() const { return rec_; }
@@ -44,6 +53,9 @@ private:
 
     FrameSetup& s_;
     Recording& rec_;
+    std::uint64_t upto_ = kAllTriangles;
+    std::uint64_t frame_upto_ = kAllTriangles;  // what frame_ holds; kAllTriangles: nothing yet
+    Framebuffer frame_;
 };
 
 // Splits a command line at spaces and tabs.

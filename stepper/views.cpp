@@ -8,6 +8,7 @@
 #include "raster/fragment.h"
 #include "scene/animation.h"
 #include "scene/encode_png.h"
+#include "scene/image.h"
 #include "scene/messages.h"
 #include "shading/color.h"
 #include "shading/ibl/environment.h"
@@ -430,6 +431,131 @@ std::string texture_png(const FrameSetup& s, const Recording&, const std::string
     const int channels = level_pixels(s, e, lv, w, h, px, note);
     png = encode_png_pixels(px.data(), w, h, channels);
     return "";
+}
+
+namespace {
+
+// A number as the views print it; +inf as "inf" (JSON gets null).
+std::string value_text(double v) { return std::isinf(v) ? (v > 0 ? "inf" : "-inf") : num(float(v)); }
+
+std::string values_text(const std::vector<std::string>& names, const std::vector<double>& v, bool bytes) {
+    std::string s;
+    for (std::size_t i = 0; i < v.size(); ++i)
+        s += (i ? ", " : "") + names[i] + " " + (bytes ? std::to_string(int(v[i])) : value_text(v[i]));
+    return s;
+}
+
+json values_json(const std::vector<double>& v, bool bytes = false) {
+    json a = json::array();
+    for (double x : v) a.push_back(bytes ? json(int(x)) : std::isfinite(x) ? json(x) : json(nullptr));
+    return a;
+}
+
+} // namespace
+
+std::string make_texel(const FrameSetup& s, const Recording&, const std::string& id, const std::string& level,
+                       const std::string& x, const std::string& y, TexelView& out) {
+    out = TexelView{};
+    Entry e;
+    std::string err = find_texture(s, id, level, e, out.info, out.level);
+    if (!err.empty()) return err;
+    out.width = out.info.level_sizes[std::size_t(out.level)].x;
+    out.height = out.info.level_sizes[std::size_t(out.level)].y;
+    long tx = 0, ty = 0;
+    if (!parse_int(x, 0, out.width - 1, tx) || !parse_int(y, 0, out.height - 1, ty))
+        return "texel '" + printable(x) + " " + printable(y) + "' of texture " + id + " level " +
+               std::to_string(out.level) + ": outside its " + std::to_string(out.width) + "x" +
+               std::to_string(out.height) + " texels (x 0.." + std::to_string(out.width - 1) + ", y 0.." +
+               std::to_string(out.height - 1) + ")";
+    out.x = int(tx);
+    out.y = int(ty);
+    const std::size_t at = std::size_t(ty) * std::size_t(out.width) + std::size_t(tx);
+    static const char* kRgba[] = {"R", "G", "B", "A"};
+    if (e.kind == Kind::Material) {
+        const Texture& tex = *e.tex;
+        const glm::vec4 v = tex.texel(out.level, out.x, out.y);  // what the samplers filter
+        out.linear_names = {"R", "G", "B", "A"};
+        out.linear = {v.r, v.g, v.b, v.a};
+        if (tex.is_unorm8()) {
+            const int C = tex.channels();
+            const std::uint8_t* p = tex.unorm8_data() + (tex.level_offset(out.level) + at) * std::size_t(C);
+            out.stored_type = "8-bit";
+            out.stored_names = packed(tex) ? std::vector<std::string>{"roughness", "metal"}
+                               : C == 1     ? std::vector<std::string>{"grey"}
+                               : C == 2     ? std::vector<std::string>{"grey", "alpha"}
+                                            : std::vector<std::string>(kRgba, kRgba + C);
+            for (int c = 0; c < C; ++c) out.stored.push_back(p[c]);
+            for (int k = 0; k < 4; ++k) {
+                const int c = tex.swizzle(k);
+                if (c == Texture::kOne) {
+                    out.decode.push_back(std::string(kRgba[k]) + " = 1 (not stored)");
+                    continue;
+                }
+                const bool srgb = tex.table(c) == srgb8_decode_table();
+                out.decode.push_back(std::string(kRgba[k]) + " = " + (srgb ? "sRGB decode of " : "") +
+                                     out.stored_names[std::size_t(c)] + " " + std::to_string(int(p[c])) +
+                                     (srgb ? "" : " / 255"));
+            }
+        } else {
+            out.stored_type = "float32";
+            out.stored_names = out.linear_names;
+            out.stored = out.linear;
+            out.decode.push_back("stored linear: read as it is");
+        }
+    } else if (e.kind == Kind::Shadow) {
+        const ShadowMap& m = *e.shadow;
+        out.face = m.cube ? out.y / m.size : -1;
+        out.fx = out.x;
+        out.fy = m.cube ? out.y % m.size : out.y;
+        const float d = m.at(m.cube ? out.face : 0, out.fx, out.fy);
+        out.stored_type = "float32";
+        out.stored_names = out.linear_names = {"distance"};
+        out.stored = out.linear = {double(d)};
+        out.decode.push_back(std::isfinite(d) ? "the distance from the light to the nearest caster"
+                                              : "no caster drawn here (+inf: always lit)");
+    } else {
+        const EquirectLevel& L = e.env->specular_level(out.level);
+        const glm::vec4 c = e.env->texels()[std::size_t(L.offset) + at];
+        out.stored_type = "float32";
+        out.stored_names = out.linear_names = {"R", "G", "B"};
+        out.stored = out.linear = {c.r, c.g, c.b};
+        out.decode.push_back("stored linear radiance: read as it is");
+    }
+    // The PNG's bytes there, by the level's rule (texture ID LEVEL).
+    int w = 0, h = 0;
+    std::vector<std::uint8_t> px;
+    std::string note;
+    const int channels = level_pixels(s, e, out.level, w, h, px, note);
+    for (int k = 0; k < channels; ++k) out.shown.push_back(px[at * std::size_t(channels) + std::size_t(k)]);
+    return "";
+}
+
+std::string TexelView::text() const {
+    std::ostringstream o;
+    o << "texel " << x << " " << y << " of texture " << info.id << " level " << level << " (" << width << "x" << height
+      << ", " << info.format << ")";
+    if (face >= 0) {
+        static const char* kFaces[] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+        o << ": face " << kFaces[face] << " texel " << fx << " " << fy;
+    }
+    o << "\n";
+    o << "  stored (" << stored_type << "): " << values_text(stored_names, stored, stored_type == "8-bit") << "\n";
+    for (const std::string& d : decode) o << "    " << d << "\n";
+    o << "  linear (what the samplers read): " << values_text(linear_names, linear, false) << "\n";
+    o << "  shown in the PNG:";
+    for (int v : shown) o << " " << v;
+    o << " (" << info.png_rule << ")\n";
+    return o.str();
+}
+
+json TexelView::json() const {
+    nlohmann::json j = {{"id", info.id},         {"level", level},          {"x", x},
+                        {"y", y},                {"width", width},          {"height", height},
+                        {"format", info.format}, {"stored_type", stored_type}, {"stored_names", stored_names},
+                        {"stored", values_json(stored, stored_type == "8-bit")}, {"decode", decode}, {"linear_names", linear_names},
+                        {"linear", values_json(linear)}, {"shown", shown}, {"text", text()}};
+    if (face >= 0) j["face"] = {{"face", face}, {"x", fx}, {"y", fy}};
+    return j;
 }
 
 // ---------------------------------------------------------------- draws

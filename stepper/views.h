@@ -102,6 +102,26 @@ std::string make_texture(const FrameSetup& s, const Recording& rec, const std::s
 std::string texture_png(const FrameSetup& s, const Recording& rec, const std::string& id, const std::string& level,
                         std::vector<std::uint8_t>& png);
 
+// ---- texel ID LEVEL X Y: one texel of a level (X, Y in the level's PNG; a
+// cube shadow map's faces stacked), as stored and as the samplers read it.
+struct TexelView {
+    TextureInfo info;
+    int level = 0, x = 0, y = 0;
+    int width = 0, height = 0;                 // the level's
+    int face = -1, fx = 0, fy = 0;             // a cube shadow map: the face and the texel in it
+    std::string stored_type;                   // "8-bit", "float32"
+    std::vector<std::string> stored_names;     // "R", "G", "B", "A"; "grey"; "roughness", "metal"; "distance"
+    std::vector<double> stored;                // as stored: bytes 0..255, or the floats
+    std::vector<std::string> decode;           // per linear channel: how it comes from the stored ones
+    std::vector<std::string> linear_names;     // "R", "G", "B", "A"; "distance"
+    std::vector<double> linear;                // what the samplers read (+inf: a shadow texel without a caster)
+    std::vector<int> shown;                    // the level's PNG at the texel (texture ID LEVEL)
+    std::string text() const;
+    nlohmann::json json() const;
+};
+std::string make_texel(const FrameSetup& s, const Recording& rec, const std::string& id, const std::string& level,
+                       const std::string& x, const std::string& y, TexelView& out);
+
 // ---- vertices N [FIRST [COUNT]]: draw N's vertices in and out.
 constexpr long kDefaultVertexRows = 16;
 constexpr long kMaxVertexRows = 1000;

@@ -17,6 +17,7 @@
 #include "scene/load_scene.h"
 #include "scene/write_image.h"
 #include "shading/color.h"
+#include "tests/cli_util.h"
 #include "tests/gltf_writer.h"
 #include "tests/scratch.h"
 #include "tests/shading_test_util.h"
@@ -444,6 +445,50 @@ TEST_CASE("KHR_lights_punctual spot: the point light's value inside the inner co
         }
     CHECK(beyond > 50);
     CHECK(within > 200);
+}
+
+TEST_CASE("--file-lights off: the flags' lights (or the default rig) replace the file's, through render") {
+    cli_test::CliSandbox box;
+    auto model = [&](bool with_light) {
+        GltfWriter g;
+        const int mat = add_material(g, {{"pbrMetallicRoughness", {{"metallicFactor", 0}, {"roughnessFactor", 0.6}}}});
+        add_quad(g, mat);
+        if (with_light) {
+            json light = {{"type", "spot"}, {"intensity", 30}, {"color", {1.0, 0.2, 0.1}},
+                          {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.3}}}};
+            g.doc["extensions"] = {{"KHR_lights_punctual", {{"lights", json::array({light})}}}};
+            g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+        }
+        finish_scene(g, with_light ? std::vector<std::pair<int, glm::vec3>>{{0, glm::vec3(0.3f, 0.0f, 2.0f)}}
+                                   : std::vector<std::pair<int, glm::vec3>>{});
+        return g.text();
+    };
+    cli_test::write_text(box.path("lit.gltf"), model(true));
+    cli_test::write_text(box.path("plain.gltf"), model(false));
+    const std::vector<std::string> view = {"--size", "48x48", "--eye", "0,0,3", "--target", "0,0,0"};
+    auto render = [&](const std::string& file, std::vector<std::string> flags, const std::string& out) {
+        std::vector<std::string> args = {file, "-o", out};
+        args.insert(args.end(), view.begin(), view.end());
+        args.insert(args.end(), flags.begin(), flags.end());
+        const cli_test::CliRun r = box.run_exe(PRAST_RENDER_EXE, args);
+        INFO(file, " ", out, ": ", r.err);
+        REQUIRE(r.code == 0);
+        return cli_test::read_bytes(box.path(out));
+    };
+    const std::vector<std::string> sun = {"--sun", "0.2,0.3,1:1,1,1"};
+    std::vector<std::string> off_sun = {"--file-lights", "off"};
+    off_sun.insert(off_sun.end(), sun.begin(), sun.end());
+    // Off with a sun: exactly the file without its light, lit by that sun.
+    CHECK(render("lit.gltf", off_sun, "a.png") == render("plain.gltf", sun, "b.png"));
+    // Off alone: the file has no light left, so the key and fill rig, as for the plain file.
+    CHECK(render("lit.gltf", {"--file-lights", "off"}, "c.png") == render("plain.gltf", {}, "d.png"));
+    // On (the default): the spot and the sun together, not the sun alone.
+    const auto both = render("lit.gltf", sun, "e.png");
+    CHECK(both == render("lit.gltf", {"--file-lights", "on", "--sun", "0.2,0.3,1:1,1,1"}, "f.png"));
+    CHECK(both != render("plain.gltf", sun, "g.png"));
+    const cli_test::CliRun bad = box.run_exe(PRAST_RENDER_EXE, {"lit.gltf", "--file-lights", "maybe"});
+    CHECK(bad.code == 2);
+    CHECK(bad.err.find("--file-lights") != std::string::npos);
 }
 
 TEST_CASE("hostile extension values: NaN-like and huge numbers, cones out of order or past pi/2, negative ranges are warnings") {

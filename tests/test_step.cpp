@@ -401,6 +401,121 @@ TEST_CASE("upto: all triangles give render's image, none the cleared frame") {
     CHECK(half.rgb != want.rgb);
 }
 
+TEST_CASE("upto N, then pixel: the pixel as it stands after N triangles, equal to upto's image") {
+    // The sky's clear colour, 4 samples (the visibility pass decides which
+    // fragments are shaded: at a point part way, others than at the end).
+    const std::vector<std::string> flags = {"--size", "160x90"};
+    const std::vector<std::pair<int, int>> pixels = grid(160, 90, 18);
+    std::string ask;
+    for (const auto& [x, y] : pixels) ask += "pixel " + std::to_string(x) + " " + std::to_string(y) + "\n";
+    CliSandbox box;
+    const CliRun end = run_step(box, flags, ask);
+    REQUIRE(end.code == 0);
+    const std::vector<std::string> at_end = pixel_blocks(end.out);
+    REQUIRE(at_end.size() == pixels.size());
+    const long kPoints[] = {0, 20000, 50000, 98432};
+    std::string commands;
+    for (long n : kPoints) commands += "upto " + std::to_string(n) + " u" + std::to_string(n) + ".png\n" + ask;
+    commands += "upto all\n" + ask;
+    const CliRun r = run_step(box, flags, commands);
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    CHECK(r.out.find("pixel X Y now explains a pixel as it stands after these 20000 triangles") != std::string::npos);
+    CHECK(r.out.find("upto all: pixel explains a pixel at the frame's end") != std::string::npos);
+    std::vector<std::string> blocks = pixel_blocks(r.out);
+    REQUIRE(blocks.size() == pixels.size() * 5);
+    // Each answer from its "pixel X Y:" line (the first after an upto follows upto's reply).
+    for (std::string& b : blocks) {
+        std::smatch m;
+        REQUIRE(std::regex_search(b, m, std::regex("(^|\n)pixel [0-9]")));
+        b = b.substr(std::size_t(m.position(0)) + (b[std::size_t(m.position(0))] == '\n'));
+    }
+    int differ_from_end = 0;
+    for (std::size_t k = 0; k < 4; ++k) {
+        const long n = kPoints[k];
+        const Rgb8 img = load_rgb8(box.path("u" + std::to_string(n) + ".png"));
+        REQUIRE(!img.empty());
+        for (std::size_t i = 0; i < pixels.size(); ++i) {
+            const std::string& b = blocks[k * pixels.size() + i];
+            const auto [x, y] = pixels[i];
+            INFO("upto " << n << " pixel " << x << " " << y << "\n" << b);
+            // The framebuffer at that point is what the explanation computes (no NOTE).
+            CHECK(b.find("NOTE") == std::string::npos);
+            const std::vector<PixelAnswer> a = pixel_answers(b);
+            REQUIRE(a.size() == 1);
+            const std::uint8_t* p = img.at(x, y);
+            CHECK(a[0].srgb[0] == p[0]);
+            CHECK(a[0].srgb[1] == p[1]);
+            CHECK(a[0].srgb[2] == p[2]);
+            if (n == 98432) {
+                CHECK(b == at_end[i]);  // all of them: the frame's end
+                continue;
+            }
+            CHECK(b.find("as the frame stands after the first " + std::to_string(n) + " of 98432 triangles") !=
+                  std::string::npos);
+            if (n == 0) {
+                CHECK(b.find("then 0 fragments") != std::string::npos);
+                CHECK(b.find("no fragment was written in the first 0 triangles: the pixel holds the clear colour") !=
+                      std::string::npos);
+            }
+            differ_from_end += pixel_answers(at_end[i])[0].srgb[0] != a[0].srgb[0];
+        }
+    }
+    CHECK(differ_from_end > 10);  // the points part way are not the frame's end
+    // upto all: the frame's end again, word for word.
+    for (std::size_t i = 0; i < pixels.size(); ++i) CHECK(blocks[4 * pixels.size() + i] == at_end[i]);
+    // A bad upto leaves the point where it was.
+    const CliRun bad = run_step(box, flags, "upto 0 z.png\nupto 98433\nupto all extra\npixel 80 45\n");
+    CHECK(bad.out.find("the pixel holds the clear colour") != std::string::npos);
+}
+
+TEST_CASE("texel: stored and linear values of a texel, sRGB bytes decoded, for every kind of texture") {
+    CliSandbox box;
+    // The checker as an sRGB base colour map: texel (2, 0) is green (0, 255, 0, 255).
+    GltfWriter g;
+    const int tex = g.texture(g.image_png(checker_png()), 9728 /*NEAREST*/, 9987 /*LINEAR_MIPMAP_LINEAR*/);
+    const int m = add_material(g, {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", tex}}}}}});
+    add_quad(g, 0.0f, json::object(), m);
+    g.scene_of_meshes();
+    const std::string file = write_gltf(box, g, "checker.gltf");
+    std::vector<std::string> flags = {file};
+    flags.insert(flags.end(), kQuadView.begin(), kQuadView.end());
+    const CliRun r = run_step(box, flags, "texel 0 0 2 0\ntexel 0 0 0 3\njson texel 0 1 1 1\ntexel 0 0 4 0\n"
+                                          "texel 0 3 0 0\ntexel nope 0 0 0\ntexel 0 0 x 0\n");
+    INFO(r.out << r.err);
+    CHECK(r.out.find("texel 2 0 of texture 0 level 0 (4x4, RGB 8-bit sRGB)\n"
+                     "  stored (8-bit): R 0, G 255, B 0\n") != std::string::npos);
+    CHECK(r.out.find("    G = sRGB decode of G 255\n") != std::string::npos);
+    CHECK(r.out.find("  linear (what the samplers read): R 0, G 1, B 0, A 1\n") != std::string::npos);
+    CHECK(r.out.find("    A = 1 (not stored)\n") != std::string::npos);
+    CHECK(r.out.find("  shown in the PNG: 0 255 0 (") != std::string::npos);
+    // Texel (0, 3): the blue quarter.
+    CHECK(r.out.find("texel 0 3 of texture 0 level 0 (4x4, RGB 8-bit sRGB)\n"
+                     "  stored (8-bit): R 0, G 0, B 255\n") != std::string::npos);
+    // Level 1 is 2x2, one texel per colour, (1, 1) the yellow one: the JSON's values.
+    const std::size_t j = r.out.find("{\"decode\"");
+    REQUIRE(j != std::string::npos);
+    const json v = json::parse(r.out.substr(j, r.out.find('\n', j) - j));
+    CHECK(v["width"] == 2);
+    CHECK(v["stored"] == json::array({255, 255, 0}));  // opaque: stored without alpha
+    CHECK(v["linear"][0] == 1.0);
+    CHECK(v["stored_type"] == "8-bit");
+    CHECK(r.out.find("error: texel '4 0' of texture 0 level 0: outside its 4x4 texels (x 0..3, y 0..3)") !=
+          std::string::npos);
+    CHECK(r.out.find("error: texture 0 level '3': no such level (levels 0..2)") != std::string::npos);
+    CHECK(r.out.find("error: texture 'nope': no such texture") != std::string::npos);
+    CHECK(r.out.find("error: texel 'x 0' of texture 0") != std::string::npos);
+    // The built-in scene's float maps, its sky and its shadow map.
+    const CliRun b = run_step(box, {"--size", "160x90", "--shadows", "on", "--shadow-size", "256"},
+                              "texel 0 0 10 10\ntexel env 0 0 0\ntexel shadow0 0 128 128\n");
+    INFO(b.out << b.err);
+    CHECK(b.code == 0);
+    CHECK(b.out.find("  stored (float32): R ") != std::string::npos);
+    CHECK(b.out.find("    stored linear: read as it is\n") != std::string::npos);
+    CHECK(b.out.find("    stored linear radiance: read as it is\n") != std::string::npos);
+    CHECK(b.out.find("  stored (float32): distance ") != std::string::npos);
+}
+
 TEST_CASE("--out: every stage as a PNG and an index.html; the final stage is render's image") {
     CliSandbox box;
     // A magenta background (the built-in sky otherwise), so that render's
@@ -994,8 +1109,8 @@ TEST_CASE("views: draws, draw, textures, texture and vertices on a small glTF, w
                      "error: usage: texture ID [LEVEL [FILE]] (textures lists the IDs)\n"
                      "error: usage: vertices N [FIRST [COUNT]] (draw N; FIRST 0 and COUNT 16 by default)\n"
                      "error: draws takes no arguments\n"
-                     "error: usage: json draws | draw N | textures | texture ID [LEVEL] | vertices N [FIRST [COUNT]] | "
-                     "tile X Y [FILTER]\n"
+                     "error: usage: json draws | draw N | textures | texture ID [LEVEL] | texel ID LEVEL X Y | "
+                     "vertices N [FIRST [COUNT]] | tile X Y [FILTER]\n"
                      "error: draw '7': no such draw (draws 0..0)\n");
 }
 

@@ -193,6 +193,15 @@ void add_render_flags(FlagSet& set, RenderParse& st, bool render_only) {
         n.help = "Without lights in the scene or the flags, render adds a key and a fill light; this leaves the "
                  "scene unlit instead.";
         n.hints = {"no-lights", "nolights", "no-rig", "unlit"};
+        Flag& f = set.value({"--file-lights"}, "on|off", "the model's own lights (default on)", "on", {"no"},
+                            [&o](const std::string& flag, const std::string& v) {
+                                if (v != "on" && v != "off") bad_value(flag, v, "expected on or off");
+                                o.file_lights = v == "on";
+                            });
+        f.help = "The lights the model file defines (glTF KHR_lights_punctual), in the file's units (lux, "
+                 "candela): on by default, with --sun and --point added to them; off leaves them out, so the "
+                 "flags' lights (or, with none, the key and fill rig) replace them.";
+        f.hints = {"model-lights", "scene-lights", "gltf-lights"};
     }
     {
         Flag& e = set.value({"--env"}, "FILE.hdr", "image-based lighting from an equirectangular .hdr", "",
@@ -320,7 +329,7 @@ void add_render_flags(FlagSet& set, RenderParse& st, bool render_only) {
                                 if (v != "on" && v != "off") bad_value(flag, v, "expected on or off");
                                 o.shadows.enabled = v == "on";
                             });
-        s.help = "Shadow maps for the directional lights.";
+        s.help = "Shadow maps: a depth map for each directional light, a cube of six for each point and spot light.";
         s.hints = {"shadow", "shadowmap", "shadow-maps"};
         Flag& z = set.value({"--shadow-size"}, "N", "shadow map texels per side", "2048", {"10", "x"},
                             [&o, integer](const std::string& flag, const std::string& v) {
@@ -534,6 +543,7 @@ std::vector<HelpRow> render_help_rows(bool render_only) {
     rows.push_back({{"--fov", "--near", "--far"}, "field of view (default 45), clip planes (fitted)"});
     rows.push_back({{"--sun", "--point"}, "lights (repeatable)"});
     rows.push_back({{"--ambient", "--no-default-lights"}, "(default 0.03); no key+fill rig"});
+    rows.push_back({{"--file-lights"}, "on|off: the model's own lights (default on)"});
     rows.push_back({{"--time", "--animation", "--camera"}, render_only ? "time 0, all animations" : "time, animation, camera"});
     rows.push_back({{"--env", "--env-intensity", "--env-rotate"}, "image-based lighting"});
     rows.push_back({{"--background", "--ibl", "--samples"}, ""});

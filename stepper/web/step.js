@@ -8,6 +8,7 @@
 const state = {
   frame: null, stages: {}, stage: "final", upto: null,
   pixel: null,      // the explained pixel [x, y]
+  pixelUpto: null,  // ... after that many triangles (the slider's point when it was asked), null: the frame's end
   selected: null,   // the selected pixel (the box), which Enter explains
   tile: null, tri: null, hover: null,
 };
@@ -426,12 +427,20 @@ function revealPanel(id) {
   right.scrollTop += d - 4;
 }
 
+// Which point of the frame the shown explanation is of.
 function updatePixelNote() {
   const f = state.frame, note = $("pixel-note");
-  if (state.pixel && state.upto !== null)
-    note.textContent = "Explained at the end of the frame (all " + f.triangles + " triangles), not at the slider's " +
-      state.upto + ": the server explains a pixel only for the whole frame.";
-  else note.textContent = "";
+  if (!state.pixel) { note.textContent = ""; return; }
+  note.textContent = state.pixelUpto !== null
+    ? "Explained as the frame stands after the first " + state.pixelUpto + " of " + f.triangles +
+      " triangles (the slider's point): the fragments of those triangles, the framebuffer's value then."
+    : "Explained at the end of the frame (all " + f.triangles + " triangles).";
+  if (state.pixelUpto !== state.upto) note.textContent += " Updating to the slider's point...";
+}
+
+// The explained pixel follows the slider (and a stage switch, which ends it).
+function reexplain() {
+  if (state.pixel && state.pixelUpto !== state.upto) showPixel(state.pixel[0], state.pixel[1]);
 }
 
 let pixelRequest = 0;
@@ -440,9 +449,11 @@ async function showPixel(x, y) {
   state.selected = [x, y];
   drawOverlay();
   try {
-    const p = await api("/api/pixel?x=" + x + "&y=" + y);
+    const upto = state.upto;
+    const p = await api("/api/pixel?x=" + x + "&y=" + y + (upto !== null ? "&upto=" + upto : ""));
     if (ticket !== pixelRequest) return;
     state.pixel = [x, y];
+    state.pixelUpto = p.upto;
     $("pixel-coords").textContent = x + " " + y;
     const body = $("history").querySelector("tbody");
     body.textContent = "";
@@ -637,6 +648,10 @@ async function showTexture() {
     v = await api("/api/texture?id=" + encodeURIComponent(t.id) + "&level=" + level);
   } catch (e) { panelError("texture-text", e); return; }
   if (ticket !== textureRequest) return;
+  texelView.pinned = null;
+  $("texel-text").hidden = true;
+  texelView.hover = [-1, -1];
+  hoverTexel(null);
   const size = v.level_sizes[level];
   $("texture-line").textContent = "texture " + v.id + ", level " + level + " of " + v.levels + ": " + size.width +
     "x" + size.height + ", " + v.format + (v.note ? "; " + v.note : "") + ". Shown as: " + v.png_rule + ".";
@@ -696,6 +711,71 @@ function placeTexture() {
   }
   for (const [id, z] of [["texture-fit", "fit"], ["texture-one", 1], ["texture-four", 4]])
     $(id).classList.toggle("on", views.zoom === z);
+}
+
+// The texel under the pointer: its coordinates at once, its values from
+// /api/texel (one request at a time, then the latest texel asked for); a
+// click keeps one, with the text `texel ID LEVEL X Y` prints.
+const texelView = { hover: null, busy: false, pinned: null };
+
+function texelAt(ev) {
+  const t = views.texView;
+  if (!t) return null;
+  const e = $("texture-channel").value === "rgb" ? $("texture-image") : $("texture-canvas");
+  const r = e.getBoundingClientRect();
+  if (!r.width || !r.height) return null;
+  const x = Math.floor((ev.clientX - r.left) / r.width * t.width);
+  const y = Math.floor((ev.clientY - r.top) / r.height * t.height);
+  if (x < 0 || y < 0 || x >= t.width || y >= t.height) return null;
+  return [x, y];
+}
+
+function texelUrl(p) {
+  return "/api/texel?id=" + encodeURIComponent(views.texture.id) + "&level=" + $("texture-level").value +
+    "&x=" + p[0] + "&y=" + p[1];
+}
+
+const fmtValues = (names, values, bytes) =>
+  names.map((n, k) => n + " " + (values[k] === null ? "inf" : bytes ? String(values[k]) : values[k].toPrecision(6))).join(", ");
+
+function texelLine(v) {
+  return "texel " + v.x + " " + v.y + (v.face ? " (face " + ["+X", "-X", "+Y", "-Y", "+Z", "-Z"][v.face.face] + " " +
+    v.face.x + " " + v.face.y + ")" : "") + ": stored " + v.stored_type + " " +
+    fmtValues(v.stored_names, v.stored, v.stored_type === "8-bit") + "  ->  linear " +
+    fmtValues(v.linear_names, v.linear, false) + "  (shown as " + v.shown.join(" ") + ")";
+}
+
+const TEXEL_HINT = "move the pointer over the texture for a texel's stored and linear values; click to keep one";
+
+async function hoverTexel(p) {
+  const same = (a, b) => a && b && a[0] === b[0] && a[1] === b[1];
+  const out = $("texel-value");
+  if (same(p, texelView.hover)) return;  // the same texel: already shown or on its way
+  texelView.hover = p;
+  if (!p) { out.textContent = views.texView ? TEXEL_HINT : ""; return; }
+  out.textContent = "texel " + p[0] + " " + p[1] + " ...";
+  if (texelView.busy) return;
+  texelView.busy = true;
+  try {
+    for (;;) {
+      const q = texelView.hover;
+      if (!q) break;
+      const v = await api(texelUrl(q));
+      if (same(texelView.hover, q)) { out.textContent = texelLine(v); break; }
+    }
+  } catch (e) { out.textContent = "error: " + e.message; }
+  texelView.busy = false;
+}
+
+async function pinTexel(p) {
+  if (!p) return;
+  texelView.pinned = p;
+  try {
+    const v = await api(texelUrl(p));
+    if (texelView.pinned !== p) return;
+    $("texel-text").textContent = v.text;
+    $("texel-text").hidden = false;
+  } catch (e) { $("texel-text").textContent = "error: " + e.message; $("texel-text").hidden = false; }
 }
 
 // ---------------------------------------------------------------- input
@@ -838,6 +918,7 @@ $("stage").addEventListener("change", () => {
   state.upto = null;
   showControls();
   showImage();
+  reexplain();
 });
 let uptoTimer = null;
 $("upto").addEventListener("input", () => {
@@ -848,6 +929,7 @@ $("upto").addEventListener("input", () => {
     state.upto = n === Number($("upto").max) ? null : n;
     showControls();
     showImage();
+    reexplain();
   }, 150);
 });
 $("grid").addEventListener("change", drawOverlay);
@@ -862,6 +944,11 @@ $("textures-panel").addEventListener("toggle", () => {
   if ($("textures-panel").open) { loadTextures(); placeTexture(); }
 });
 $("texture-level").addEventListener("change", () => views.texture && showTexture());
+for (const id of ["texture-image", "texture-canvas"]) {
+  $(id).addEventListener("pointermove", (ev) => hoverTexel(texelAt(ev)));
+  $(id).addEventListener("pointerleave", () => hoverTexel(null));
+  $(id).addEventListener("click", (ev) => pinTexel(texelAt(ev)));
+}
 $("texture-channel").addEventListener("change", () => showChannel(null));
 $("texture-fit").addEventListener("click", () => { views.zoom = "fit"; placeTexture(); });
 $("texture-one").addEventListener("click", () => { views.zoom = 1; placeTexture(); });

@@ -260,7 +260,9 @@ def number_checks(port, frame):
     cases = []
     for v in junk:
         cases += ["/api/pixel?x=%s&y=1" % v, "/api/pixel?x=1&y=%s" % v, "/api/tri?n=%s" % v, "/api/upto?n=%s" % v,
-                  "/api/tile?x=%s&y=0" % v, "/api/tile?x=0&y=%s" % v]
+                  "/api/tile?x=%s&y=0" % v, "/api/tile?x=0&y=%s" % v, "/api/pixel?x=1&y=1&upto=%s" % v,
+                  "/api/texel?id=0&level=%s&x=0&y=0" % v, "/api/texel?id=0&level=0&x=%s&y=0" % v,
+                  "/api/texel?id=0&level=0&x=0&y=%s" % v]
     cases += ["/api/pixel?x=%d&y=0" % w, "/api/pixel?x=0&y=%d" % h, "/api/pixel?x=%d&y=%d" % (w, h),
               "/api/tri?n=%d" % tris, "/api/upto?n=%d" % (tris + 1), "/api/upto?n=-1",
               "/api/tile?x=%d&y=0" % frame["tiles_x"], "/api/tile?x=0&y=%d" % frame["tiles_y"],
@@ -268,7 +270,12 @@ def number_checks(port, frame):
               "/api/pixel?", "/api/pixel?&&&", "/api/pixel?x&y", "/api/pixel?x=&y=", "/api/pixel?X=1&Y=1",
               "/api/stage?name=<script>", "/api/stage?name=../../etc/passwd", "/api/stage?name=final&name=depth",
               "/api/stage?name=%00", "/api/stage?name=" + "A" * 5000, "/api/nope", "/api/", "/api", "/api/frame/x",
-              "/api/pixel/1/1", "/apiframe", "/api/frame%00", "/%3cscript%3ealert(1)%3c/script%3e"]
+              "/api/pixel/1/1", "/apiframe", "/api/frame%00", "/%3cscript%3ealert(1)%3c/script%3e",
+              "/api/pixel?x=1&y=1&upto=%d" % (tris + 1), "/api/pixel?x=1&y=1&upto=1&upto=2",
+              "/api/texel?id=0&level=0&x=100000&y=0", "/api/texel?id=0&level=0&x=0&y=100000",
+              "/api/texel?id=0&level=99&x=0&y=0", "/api/texel?id=0&x=0&y=0", "/api/texel?id=0&level=0&x=0",
+              "/api/texel?id=0&level=0&x=0&y=0&x=1", "/api/texel?id=<script>&level=0&x=0&y=0",
+              "/api/texel?id=0&id=1&level=0&x=0&y=0", "/api/texel"]
     for path in cases:
         status, headers, body = request(port, path)
         if path == "/api/stage?name=final&name=depth":
@@ -277,12 +284,14 @@ def number_checks(port, frame):
         message = check_error(path, (status, headers, body), (400, 404))
         assert "script" not in message and "passwd" not in message, (path, message)
     # The edges of each range are valid.
-    for path in ("/api/pixel?x=0&y=0", "/api/pixel?x=%d&y=%d" % (w - 1, h - 1), "/api/tri?n=0",
-                 "/api/tri?n=%d" % (tris - 1), "/api/upto?n=0", "/api/upto?n=%d" % tris,
-                 "/api/tile?x=%d&y=%d" % (frame["tiles_x"] - 1, frame["tiles_y"] - 1)):
+    edges = ("/api/pixel?x=0&y=0", "/api/pixel?x=%d&y=%d" % (w - 1, h - 1), "/api/tri?n=0",
+             "/api/tri?n=%d" % (tris - 1), "/api/upto?n=0", "/api/upto?n=%d" % tris,
+             "/api/tile?x=%d&y=%d" % (frame["tiles_x"] - 1, frame["tiles_y"] - 1),
+             "/api/pixel?x=0&y=0&upto=0", "/api/pixel?x=0&y=0&upto=%d" % tris, "/api/texel?id=0&level=0&x=0&y=0")
+    for path in edges:
         status, headers, _ = request(port, path)
         assert status == 200 and headers["content-type"] in ("application/json", "image/png"), (path, status)
-    return len(cases) + 7
+    return len(cases) + len(edges)
 
 
 def malformed_checks(port):
@@ -738,10 +747,11 @@ def slow_reader_checks(port):
     pid = server_pid(port)
     before = rss_kib(pid)
     one = ("GET /api/tile?x=2&y=1 HTTP/1.1\r\nHost: 127.0.0.1:%d\r\n\r\n" % port).encode()
-    conns = []
+    conns, connected = [], []
     for _ in range(8):
         c = socket.create_connection(("127.0.0.1", port), timeout=60)
         c.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        connected.append(time.monotonic())
         c.sendall(one * (KEEP_ALIVE_REQUESTS - 1))
         conns.append(c)
     # Quiet: no CPU spent for 0.3 s (a sanitizer build takes longer to get there).
@@ -754,9 +764,16 @@ def slow_reader_checks(port):
         last = now
     took = page_load(port)
     states = [tcp_state(c) for c in conns]
+    ages = [time.monotonic() - t for t in connected]
     during = rss_kib(pid)
     assert took < 3, "a page load took %.1f s while 8 clients did not read their answers" % took
-    assert states == ["01"] * 8, ("clients that did not read were closed before the page load ended", states)
+    # The server may close a client once it has made no progress for 5 s;
+    # its last progress is no earlier than its connect, so one connected
+    # less than 5 s ago must still be open (on a slow build making the
+    # answers takes longer, and the oldest may rightly be gone).
+    early = [(i, st, round(a, 1)) for i, (st, a) in enumerate(zip(states, ages)) if st != "01" and a < 4.9]
+    assert not early, ("clients that did not read were closed within 5 s of connecting", early)
+    still_open = states.count("01")
     # Bounded while they wait (16 MiB of waiting answers, and what the
     # workers used to make them), and given back once they are gone.
     assert during - before < 256 * 1024, ("VmRSS grew by %d KiB" % (during - before))
@@ -770,11 +787,17 @@ def slow_reader_checks(port):
         c.close()
     assert "01" not in states, ("clients that read nothing were still connected after 60 s", states)
     check_good(port)
-    time.sleep(0.5)  # the server gives memory back when idle
-    after = rss_kib(pid)
+    # The server gives memory back when idle (a check every 0.1 s): on a
+    # loaded machine that may take more than one look.
+    deadline = time.monotonic() + 10
+    while True:
+        time.sleep(0.5)
+        after = rss_kib(pid)
+        if after - before < 8 * 1024 or time.monotonic() > deadline:
+            break
     assert after - before < 8 * 1024, ("VmRSS %d KiB before, %d after" % (before, after))
-    print("hostile: 8 clients not reading 19 answers each: page load %.2f s, VmRSS %d -> %d -> %d KiB"
-          % (took, before, during, after), flush=True)
+    print("hostile: 8 clients not reading 19 answers each: page load %.2f s with %d of them open, "
+          "VmRSS %d -> %d -> %d KiB" % (took, still_open, before, during, after), flush=True)
     return 8 * 19
 
 

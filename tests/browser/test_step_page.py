@@ -148,6 +148,21 @@ def api_checks(step):
             assert code == 200 and p["text"] == step_text(step, "pixel %d %d\n" % (x, y)), (x, y)
             assert p["text"].count("\nsrgb8 ") == 1
             assert len(p["sample_list"]) == frame["samples"] and page_samples(p) == samples_in_text(p["text"]), p
+        # At the slider's point: the pixel after the first N triangles, as
+        # `upto N` then `pixel X Y` explains it; at all of them, the frame's end.
+        with tempfile.TemporaryDirectory() as tmp:
+            for n in (0, 30000, frame["triangles"]):
+                code, p = get(base + "/api/pixel?x=160&y=100&upto=%d" % n)
+                text = step_text(step, "upto %d %s\npixel 160 100\n" % (n, os.path.join(tmp, "u.png")))
+                text = text[text.index("pixel 160 100:"):]
+                assert code == 200 and p["text"] == text, n
+                assert p["upto"] == (None if n == frame["triangles"] else n) and p["triangles"] == frame["triangles"], p
+        assert get(base + "/api/pixel?x=160&y=100&upto=%d" % frame["triangles"])[1] == get(base + "/api/pixel?x=160&y=100")[1]
+        assert "holds the clear colour" in get(base + "/api/pixel?x=160&y=100&upto=0")[1]["text"]
+        # One texel, as `texel ID LEVEL X Y` prints it.
+        for q, command in (("id=0&level=0&x=5&y=7", "texel 0 0 5 7"), ("id=env&level=2&x=3&y=4", "texel env 2 3 4")):
+            code, v = get(base + "/api/texel?" + q)
+            assert code == 200 and v["text"] == step_text(step, command + "\n"), (q, v)
         code, t = get(base + "/api/tri?n=98372")
         assert code == 200 and t["text"] == step_text(step, "tri 98372\n")
         code, t = get(base + "/api/tile?x=2&y=1")
@@ -180,12 +195,17 @@ def api_checks(step):
                ("/api/pixel?x=" + "9" * 9000, 414), ("/api/draw?n=25", 400), ("/api/draw", 400),
                ("/api/texture?id=nope", 404), ("/api/texture", 400), ("/api/texture?id=0&level=99", 400),
                ("/api/texture.png?id=env&level=-1", 400), ("/api/vertices?draw=0&count=1001", 400),
-               ("/api/vertices?draw=0&first=999999", 400), ("/api/vertices", 400)]
+               ("/api/vertices?draw=0&first=999999", 400), ("/api/vertices", 400),
+               ("/api/pixel?x=1&y=1&upto=-1", 400), ("/api/pixel?x=1&y=1&upto=98433", 400),
+               ("/api/pixel?x=1&y=1&upto=1e3", 400), ("/api/pixel?x=1&y=1&upto=1&upto=1", 400),
+               ("/api/texel?id=nope&level=0&x=0&y=0", 404), ("/api/texel?id=0&level=0&x=0", 400),
+               ("/api/texel?id=0&x=0&y=0", 400), ("/api/texel?id=0&level=0&x=-1&y=0", 400),
+               ("/api/texel?id=env&level=7&x=0&y=999999", 400), ("/api/texel", 400)]
         rng = random.Random(10)
         alphabet = "0123456789-+.e%&=?/xyn abc\u00e9"
         for _ in range(150):
             endpoint = rng.choice(["/api/pixel", "/api/tri", "/api/tile", "/api/upto", "/api/stage", "/api/draw",
-                                   "/api/texture", "/api/texture.png", "/api/vertices"])
+                                   "/api/texture", "/api/texture.png", "/api/vertices", "/api/texel"])
             query = "".join(rng.choice(alphabet) for _ in range(rng.randint(0, 30)))
             bad.append((endpoint + "?" + urllib.parse.quote(query, safe="&=%"), None))
         for path, status in bad:
@@ -489,9 +509,31 @@ def page_checks(driver, step, server, url):
     X, Y, ex, ey = screen_point(rect(driver, img), W, H, 60, 160)
     pointer(driver, X, Y, click=True)
     wait.until(lambda d: d.find_element(By.ID, "pixel-coords").text == "%d %d" % (ex, ey))
+    head = "pixel %d %d:" % (ex, ey)
+    wait.until(lambda d: d.find_element(By.ID, "pixel-text").get_attribute("textContent").startswith(head) and
+               "Updating" not in d.find_element(By.ID, "pixel-note").text)
     note = driver.find_element(By.ID, "pixel-note").text
-    assert "all %d triangles" % frame["triangles"] in note and "not at the slider's 1000" in note, note
-    print("slider: the frame after 1000 triangles; a click says: " + note)
+    assert "after the first 1000 of %d triangles" % frame["triangles"] in note, note
+    # The explanation is of that point: `upto 1000` then `pixel X Y`, exactly.
+    with tempfile.TemporaryDirectory() as tmp:
+        expected = step_text(step, "upto 1000 %s\npixel %d %d\n" % (os.path.join(tmp, "u.png"), ex, ey))
+    expected = expected[expected.index(head):]
+    shown = driver.find_element(By.ID, "pixel-text").get_attribute("textContent")
+    assert shown == expected, (shown[:300], expected[:300])
+    # Back to the end: the slider at all triangles explains the frame's end.
+    driver.execute_script("const u = document.getElementById('upto'); u.value = u.max;"
+                          "u.dispatchEvent(new Event('input'));")
+    wait.until(lambda d: "all %d triangles" % frame["triangles"] in d.find_element(By.ID, "pixel-note").text and
+               "Updating" not in d.find_element(By.ID, "pixel-note").text)
+    assert driver.find_element(By.ID, "pixel-text").get_attribute("textContent") == step_text(
+        step, "pixel %d %d\n" % (ex, ey))
+    print("slider: after 1000 triangles a click explains the pixel then (step's upto 1000, pixel text exactly): " +
+          note + "; at the end, the frame's end again")
+    driver.execute_script("const u = document.getElementById('upto'); u.value = 1000;"
+                          "u.dispatchEvent(new Event('input'));")
+    wait_image(driver, wait, W, "/api/upto?n=1000")
+    wait.until(lambda d: "after the first 1000 " in d.find_element(By.ID, "pixel-note").text and
+               "Updating" not in d.find_element(By.ID, "pixel-note").text)
 
     # Bad requests: JSON errors, and the server goes on.
     for path, status in (("/api/pixel?x=-1&y=0", 400), ("/api/pixel?x=320&y=0", 400), ("/api/tri?n=abc", 400),
@@ -579,6 +621,17 @@ def view_panel_checks(driver, wait, base):
     assert img.value_of_css_property("image-rendering") == "pixelated"
     driver.find_element(By.ID, "texture-four").click()
     assert rect(driver, img)[2] - rect(driver, img)[0] == 4 * size["width"]
+    # The texel under the pointer, and a click keeps its `texel` text.
+    driver.execute_script("arguments[0].scrollIntoView({block: 'center', inline: 'start'})", img)
+    r = rect(driver, img)
+    tx, ty = 5, 3
+    pointer(driver, r[0] + 4 * tx + 2, r[1] + 4 * ty + 2)
+    wait.until(lambda d: text("texel-value").startswith("texel %d %d" % (tx, ty)) and "..." not in text("texel-value"))
+    hover = text("texel-value")
+    pointer(driver, r[0] + 4 * tx + 2, r[1] + 4 * ty + 2, click=True)
+    expected = get(base + "/api/texel?id=env&level=2&x=%d&y=%d" % (tx, ty))[1]["text"]  # step's text (api_checks)
+    wait.until(lambda d: d.find_element(By.ID, "texel-text").get_attribute("textContent") == expected)
+    assert expected.startswith("texel %d %d of texture env level 2" % (tx, ty)), expected
     driver.find_element(By.ID, "texture-one").click()
     assert rect(driver, img)[2] - rect(driver, img)[0] == size["width"]
     Select(driver.find_element(By.ID, "texture-channel")).select_by_value("r")
@@ -606,6 +659,8 @@ def view_panel_checks(driver, wait, base):
     driver.save_screenshot("/tmp/h6-views-1280x800.png")
     driver.execute_script("document.getElementById('textures-panel').scrollIntoView({block: 'start'})")
     driver.save_screenshot("/tmp/h6-textures-1280x800.png")
+    print("texel: the pointer over texel %d %d of env level 2 shows '%s'; a click shows its texel text exactly"
+          % (tx, ty, hover))
     print("textures: env level 2 shown at %dx%d as its JSON says, pixelated, 4x / 1:1 / fit, channel R in a canvas"
           % tuple(natural))
 

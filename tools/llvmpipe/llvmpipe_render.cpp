@@ -49,6 +49,7 @@
 #include "scene/camera.h"
 #include "scene/image.h"
 #include "scene/write_image.h"
+#include "shading/brdf.h"
 
 using namespace prast;
 
@@ -106,9 +107,13 @@ vec3 display(vec3 c) {
 )";
 
 // The conventions' Cook-Torrance, line for line with shading/brdf.h and
-// shading/surface.h (default BRDF). MAPS (bits: 1 base, 2 metal-rough, 4 rough,
-// 8 metal, 16 normal, 32 occlusion, 64 emissive) and LINEAR_OUT (1: linear
-// radiance for the MSAA resolve) are #defined before it.
+// shading/surface.h (default BRDF), with KHR_materials_specular's F0 / F90
+// and KHR_materials_clearcoat's lobe as evaluate_brdf() has them. MAPS (bits:
+// 1 base, 2 metal-rough, 4 rough, 8 metal, 16 normal, 32 occlusion, 64
+// emissive, 128 specular, 256 specular colour, 512 clearcoat, 1024 clearcoat
+// roughness, 2048 clearcoat normal, 4096 sheen colour, 8192 sheen roughness;
+// the sheen's albedo table of brdf.h is t_sheen_E) and LINEAR_OUT (1: linear radiance for
+// the MSAA resolve) are #defined before it.
 const char* kFragmentShader = R"(
 #define HAS(bit) ((MAPS & bit) != 0)
 in vec3 v_position; in vec3 v_normal; in vec2 v_uv; in vec4 v_tangent;
@@ -117,6 +122,14 @@ uniform vec4 u_base_color_factor;
 uniform float u_metallic_factor, u_roughness_factor, u_normal_scale, u_occlusion_strength, u_ior;
 uniform vec3 u_emissive_factor;
 uniform sampler2D t_base, t_mr, t_rough, t_metal, t_normal, t_occlusion, t_emissive;
+uniform int u_specular_ext;     // KHR_materials_specular present
+uniform float u_specular_factor;
+uniform vec3 u_specular_color_factor;
+uniform float u_clearcoat, u_clearcoat_roughness, u_clearcoat_normal_scale;  // u_clearcoat 0: no coat
+uniform sampler2D t_specular, t_specular_color, t_clearcoat, t_clearcoat_rough, t_clearcoat_normal;
+uniform vec3 u_sheen_color_factor;  // 0: no sheen
+uniform float u_sheen_roughness_factor;
+uniform sampler2D t_sheen_color, t_sheen_rough, t_sheen_E;
 uniform vec3 u_eye;
 uniform int u_light_count;
 uniform vec4 u_light[8];        // xyz: direction towards the light (w = 0) or position (w = 1)
@@ -127,6 +140,19 @@ const float PI = 3.14159265358979;
 vec3 safe_normalize(vec3 v, vec3 fallback) {
     float len2 = dot(v, v);
     return len2 > 1e-20 ? v / sqrt(len2) : fallback;
+}
+
+// KHR_materials_sheen's Charlie distribution and visibility (brdf.h).
+float sheen_l(float x, float a) {
+    float t = (1.0 - a) * (1.0 - a);
+    return mix(21.5473, 25.3245, t) / (1.0 + mix(3.82987, 3.32435, t) * pow(x, mix(0.19823, 0.16801, t))) +
+           mix(-1.97760, -1.27393, t) * x + mix(-4.32054, -4.85967, t);
+}
+float sheen_lambda(float c, float a) {
+    return c < 0.5 ? exp(sheen_l(c, a)) : exp(2.0 * sheen_l(0.5, a) - sheen_l(1.0 - c, a));
+}
+float sheen_E(float NoV, float r) {  // the table's texel centres: n.v i / 31, r j / 15
+    return texture(t_sheen_E, vec2((NoV * 31.0 + 0.5) / 32.0, (r * 15.0 + 0.5) / 16.0)).r;
 }
 
 void main() {
@@ -143,9 +169,39 @@ void main() {
     vec3 emissive = u_emissive_factor;
     if (HAS(64)) emissive *= texture(t_emissive, v_uv).rgb;
 
+    float spec = u_specular_factor;
+    vec3 spec_color = u_specular_color_factor;
+    if (HAS(128)) spec *= texture(t_specular, v_uv).a;
+    if (HAS(256)) spec_color *= texture(t_specular_color, v_uv).rgb;
+    spec = clamp(spec, 0.0, 1.0);
+    float cc = u_clearcoat, ccr = u_clearcoat_roughness;
+    if (HAS(512)) cc *= texture(t_clearcoat, v_uv).r;
+    if (HAS(1024)) ccr *= texture(t_clearcoat_rough, v_uv).g;
+    cc = clamp(cc, 0.0, 1.0);
+    ccr = clamp(ccr, 0.0, 1.0);
+    vec3 sheen = u_sheen_color_factor;
+    float sr = u_sheen_roughness_factor;
+    if (HAS(4096)) sheen *= texture(t_sheen_color, v_uv).rgb;
+    if (HAS(8192)) sr *= texture(t_sheen_rough, v_uv).a;
+    sheen = clamp(sheen, 0.0, 1.0);
+    float rs = clamp(sr, 0.045, 1.0), as = rs * rs;
+    float smax = max(sheen.r, max(sheen.g, sheen.b));
+
     vec3 N = safe_normalize(v_normal, vec3(0.0, 0.0, 1.0));
     float flip = gl_FrontFacing ? 1.0 : -1.0;
     vec3 n = N * flip;
+    vec3 nc = n;  // the coat's normal: the geometric one unless it has its own map
+    if (HAS(2048)) {
+        vec3 T = safe_normalize(v_tangent.xyz - N * dot(N, v_tangent.xyz), vec3(0.0));
+        if (dot(T, T) > 0.0) {
+            float w = v_tangent.w < 0.0 ? -1.0 : 1.0;
+            vec3 B = cross(N, T) * w;
+            vec3 nt = texture(t_clearcoat_normal, v_uv).rgb * 2.0 - 1.0;
+            nt.xy *= u_clearcoat_normal_scale;
+            nt = safe_normalize(nt, vec3(0.0, 0.0, 1.0));
+            nc = safe_normalize(T * nt.x + B * nt.y + N * nt.z, N) * flip;
+        }
+    }
     if (HAS(16)) {
         vec3 T = safe_normalize(v_tangent.xyz - N * dot(N, v_tangent.xyz), vec3(0.0));
         if (dot(T, T) > 0.0) {
@@ -162,9 +218,19 @@ void main() {
     float alpha = r * r, a2 = alpha * alpha;
     float f0d = (1.0 - u_ior) / (1.0 + u_ior);
     vec3 F0 = mix(vec3(f0d * f0d), base.rgb, metallic);
+    float F90 = 1.0;
+    if (u_specular_ext != 0) {
+        F0 = mix(min(vec3(f0d * f0d) * spec_color, vec3(1.0)) * spec, base.rgb, metallic);
+        F90 = mix(spec, 1.0, metallic);
+    }
     float k = (r + 1.0) * (r + 1.0) / 8.0;
     float NoV = clamp(dot(n, v), 0.0, 1.0);
-    vec3 Lo = emissive;
+    // The coat: F_coat at n_c.v weights its lobe and attenuates what lies beneath.
+    float rc = clamp(ccr, 0.045, 1.0), ac2 = rc * rc * rc * rc, kc = (rc + 1.0) * (rc + 1.0) / 8.0;
+    float NcV = clamp(dot(nc, v), 0.0, 1.0);
+    float Fc = 0.04 + 0.96 * pow(1.0 - NcV, 5.0);
+    float atten = cc > 0.0 ? 1.0 - cc * Fc : 1.0;
+    vec3 Lo = emissive * atten;
     for (int i = 0; i < u_light_count; ++i) {
         vec3 l, radiance;
         if (u_light[i].w == 0.0) { l = u_light[i].xyz; radiance = u_light_radiance[i]; }
@@ -181,13 +247,28 @@ void main() {
         float NoL = clamp(dot(n, l), 0.0, 1.0);
         float NoH = clamp(dot(n, h), 0.0, 1.0);
         float VoH = clamp(dot(v, h), 0.0, 1.0);
-        vec3 F = F0 + (1.0 - F0) * pow(1.0 - VoH, 5.0);
+        vec3 F = F0 + (F90 - F0) * pow(1.0 - VoH, 5.0);
         float dd = NoH * NoH * (a2 - 1.0) + 1.0;
         float D = a2 / (PI * dd * dd);
         float G = (NoV / (NoV * (1.0 - k) + k)) * (NoL / (NoL * (1.0 - k) + k));
         vec3 specular = D * G * F / (4.0 * max(NoV, 1e-4) * max(NoL, 1e-4));
         vec3 kd = (1.0 - F) * (1.0 - metallic);
-        Lo += (kd * base.rgb / PI + specular) * radiance * NoL;
+        vec3 f = kd * base.rgb / PI + specular;
+        if (smax > 0.0) {  // the sheen over the base, which keeps what it leaves
+            float Ds = (2.0 + 1.0 / as) * pow(max(1.0 - NoH * NoH, 0.0), 0.5 / as) / (2.0 * PI);
+            float den = (1.0 + sheen_lambda(NoV, as) + sheen_lambda(NoL, as)) * (4.0 * NoV * NoL);
+            float Vs = den > 0.0 ? min(1.0 / den, 1.0) : 0.0;
+            float scaling = min(1.0 - smax * sheen_E(NoV, rs), 1.0 - smax * sheen_E(NoL, rs));
+            f = f * scaling + sheen * (Ds * Vs);
+        }
+        Lo += f * atten * radiance * NoL;
+        if (cc > 0.0) {
+            float NcL = clamp(dot(nc, l), 0.0, 1.0), NcH = clamp(dot(nc, h), 0.0, 1.0);
+            float dc = NcH * NcH * (ac2 - 1.0) + 1.0;
+            float Dc = ac2 / (PI * dc * dc);
+            float Gc = (NcV / (NcV * (1.0 - kc) + kc)) * (NcL / (NcL * (1.0 - kc) + kc));
+            Lo += cc * Fc * Dc * Gc / (4.0 * max(NcV, 1e-4) * max(NcL, 1e-4)) * radiance * NcL;
+        }
     }
     Lo += u_ambient * base.rgb * occlusion;
     o_color = LINEAR_OUT != 0 ? vec4(Lo, 1.0) : vec4(display(Lo), 1.0);
@@ -391,19 +472,36 @@ int main(int argc, char** argv) {
         }
         return t;
     };
+    constexpr int kUnits = 14;  // the seven core maps, then the specular, clearcoat and sheen ones
     struct GpuMaterial {
         const Material* m;
-        GLuint tex[7];
+        GLuint tex[kUnits];
         int maps = 0;
     };
     std::vector<GpuMaterial> materials;
     for (const Material& m : scene.materials) {
         GpuMaterial g{&m, {texture(m.base_color, true), texture(m.metallic_roughness, false),
                           texture(m.roughness, false), texture(m.metallic, false), texture(m.normal, false),
-                          texture(m.occlusion, false), texture(m.emissive, true)}};
-        for (int i = 0; i < 7; ++i) g.maps |= g.tex[i] ? 1 << i : 0;
+                          texture(m.occlusion, false), texture(m.emissive, true),
+                          texture(m.specular_texture, false), texture(m.specular_color_texture, true),
+                          texture(m.clearcoat_texture, false), texture(m.clearcoat_roughness_texture, false),
+                          texture(m.clearcoat_normal_texture, false), texture(m.sheen_color_texture, true),
+                          texture(m.sheen_roughness_texture, false)}};
+        for (int i = 0; i < kUnits; ++i) g.maps |= g.tex[i] ? 1 << i : 0;
         materials.push_back(g);
     }
+    // The sheen's albedo table (brdf.h), bilinear between its texel centres, on the unit after the maps.
+    GLuint sheen_table = 0;
+    glGenTextures(1, &sheen_table);
+    glActiveTexture(GLenum(GL_TEXTURE0 + kUnits));
+    glBindTexture(GL_TEXTURE_2D, sheen_table);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, kSheenNoV, kSheenRough, 0, GL_RED, GL_FLOAT, sheen_albedo_table().data());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    glActiveTexture(GL_TEXTURE0);
     glFinish();  // the uploads and mip chains are done
     const double textures_ms = ms_since(t_tex);
     // --stats: render's two load lines (bench --side-by-side reads them).
@@ -420,6 +518,8 @@ int main(int argc, char** argv) {
         GLuint id = 0;
         GLint base_color_factor, metallic_factor, roughness_factor, normal_scale, occlusion_strength, ior,
             emissive_factor;
+        GLint specular_ext, specular_factor, specular_color_factor, clearcoat, clearcoat_roughness,
+            clearcoat_normal_scale, sheen_color_factor, sheen_roughness_factor;
     };
     std::map<int, Program> programs;
     auto program_for = [&](int maps) -> const Program& {
@@ -430,8 +530,11 @@ int main(int argc, char** argv) {
         Program p;
         p.id = link_program(kVertexShader, program_source(tonemap, defines, kFragmentShader).c_str());
         glUseProgram(p.id);
-        const char* samplers[7] = {"t_base", "t_mr", "t_rough", "t_metal", "t_normal", "t_occlusion", "t_emissive"};
-        for (int i = 0; i < 7; ++i) glUniform1i(loc(p.id, samplers[i]), i);
+        const char* samplers[kUnits] = {"t_base", "t_mr", "t_rough", "t_metal", "t_normal", "t_occlusion",
+                                        "t_emissive", "t_specular", "t_specular_color", "t_clearcoat",
+                                        "t_clearcoat_rough", "t_clearcoat_normal", "t_sheen_color", "t_sheen_rough"};
+        for (int i = 0; i < kUnits; ++i) glUniform1i(loc(p.id, samplers[i]), i);
+        glUniform1i(loc(p.id, "t_sheen_E"), kUnits);
         glUniformMatrix4fv(loc(p.id, "u_view_proj"), 1, GL_FALSE, &vp[0][0]);
         glUniform3f(loc(p.id, "u_eye"), camera.eye.x, camera.eye.y, camera.eye.z);
         glUniform1i(loc(p.id, "u_light_count"), GLint(lights.size()));
@@ -452,6 +555,14 @@ int main(int argc, char** argv) {
         p.occlusion_strength = loc(p.id, "u_occlusion_strength");
         p.ior = loc(p.id, "u_ior");
         p.emissive_factor = loc(p.id, "u_emissive_factor");
+        p.specular_ext = loc(p.id, "u_specular_ext");
+        p.specular_factor = loc(p.id, "u_specular_factor");
+        p.specular_color_factor = loc(p.id, "u_specular_color_factor");
+        p.clearcoat = loc(p.id, "u_clearcoat");
+        p.clearcoat_roughness = loc(p.id, "u_clearcoat_roughness");
+        p.clearcoat_normal_scale = loc(p.id, "u_clearcoat_normal_scale");
+        p.sheen_color_factor = loc(p.id, "u_sheen_color_factor");
+        p.sheen_roughness_factor = loc(p.id, "u_sheen_roughness_factor");
         return programs.emplace(maps, p).first->second;
     };
     for (const GpuMaterial& gm : materials) program_for(gm.maps);
@@ -526,7 +637,16 @@ int main(int argc, char** argv) {
             glUniform1f(p.occlusion_strength, m.occlusion_strength);
             glUniform1f(p.ior, m.ior);
             glUniform3fv(p.emissive_factor, 1, &m.emissive_factor[0]);
-            for (int i = 0; i < 7; ++i) {
+            glUniform1i(p.specular_ext, m.has_specular ? 1 : 0);
+            glUniform1f(p.specular_factor, m.specular_factor);
+            glUniform3fv(p.specular_color_factor, 1, &m.specular_color_factor[0]);
+            glUniform1f(p.clearcoat, m.has_clearcoat ? m.clearcoat_factor : 0.0f);
+            glUniform1f(p.clearcoat_roughness, m.clearcoat_roughness_factor);
+            glUniform1f(p.clearcoat_normal_scale, m.clearcoat_normal_scale);
+            const glm::vec3 sheen = m.has_sheen ? m.sheen_color_factor : glm::vec3(0.0f);
+            glUniform3fv(p.sheen_color_factor, 1, &sheen[0]);
+            glUniform1f(p.sheen_roughness_factor, m.sheen_roughness_factor);
+            for (int i = 0; i < kUnits; ++i) {
                 glActiveTexture(GLenum(GL_TEXTURE0 + i));
                 glBindTexture(GL_TEXTURE_2D, gm.tex[i]);
             }

@@ -1,16 +1,17 @@
 #!/bin/sh
-# CI step: prast as a library. Installs the build into a temporary prefix,
+# prast as a library (the CTest test `examples`, so CI runs it in the README's
+# test command). Installs the build into a temporary prefix,
 # then configures, builds and runs both examples/ projects against it with
 # find_package(prast) alone (CMAKE_PREFIX_PATH), and checks that the
 # consumers compile with our determinism flags and without our warning flags.
-#   sh .ci/steps/10-examples.sh [BUILD_DIR]      (default: build; from the top folder)
-# Also run by CTest as `examples`, with PRAST_EXAMPLES_DIR set: then the
+#   sh scripts/check-examples.sh [BUILD_DIR]      (default: build; from the top folder)
+# CTest sets PRAST_EXAMPLES_DIR: then the
 # prefix and the example builds go to fixed folders under it (wiped first,
 # kept afterwards), so that a compiler launcher such as ccache
 # (CMAKE_CXX_COMPILER_LAUNCHER in the environment) finds its cache again.
 set -e
 build=$(cd "${1:-build}" && pwd)
-top=$(cd "$(dirname "$0")/../.." && pwd)
+top=$(cd "$(dirname "$0")/.." && pwd)
 if [ -n "$PRAST_EXAMPLES_DIR" ]; then
   rm -rf "$PRAST_EXAMPLES_DIR"
   mkdir -p "$PRAST_EXAMPLES_DIR/prefix" "$PRAST_EXAMPLES_DIR/work"
