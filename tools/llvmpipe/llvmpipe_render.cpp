@@ -7,15 +7,19 @@
 // shades with a GLSL port of the conventions' Cook-Torrance (shading/brdf.h,
 // surface.h): metal-roughness maps, tangent-space normal maps, occlusion,
 // emissive, suns and point lights, the flat ambient term, exposure and the ACES
-// / neutral / clamp tone maps (the sRGB encoding is the target's). Textures are uploaded in
+// / neutral / clamp tone maps (the sRGB encoding is the target's), and the
+// KHR_materials_specular, _clearcoat and _sheen lobes with their maps
+// (docs/shading.md, "Against llvmpipe", has the agreement and
+// make_lobe_models.py the test models). Textures are uploaded in
 // their 8-bit form (sRGB formats for colour maps) and glGenerateMipmap builds
 // their chains; sampling is trilinear, as render's.
 //
 // Not ported (the bench workloads do not use them): measured conductors (Pc),
-// alpha MASK, debug views, image-based lighting, shadows, blending.
+// alpha MASK, debug views, image-based lighting, shadows, blending,
+// KHR_texture_transform, UV sets other than TEXCOORD_0, vertex colours.
 //
 // Set up as a GL application would for speed, so that the comparison is fair
-// to llvmpipe: one fragment program per combination of maps and tone map
+// to llvmpipe: one fragment program per combination of maps, layered lobes and tone map
 // (shader permutations from one source with #defines, not branches on
 // uniforms), vertex and index buffers, 8-bit textures with sRGB formats and
 // generated mips, and an 8-bit sRGB framebuffer object (GL_FRAMEBUFFER_SRGB:
@@ -107,12 +111,15 @@ vec3 display(vec3 c) {
 )";
 
 // The conventions' Cook-Torrance, line for line with shading/brdf.h and
-// shading/surface.h (default BRDF), with KHR_materials_specular's F0 / F90
-// and KHR_materials_clearcoat's lobe as evaluate_brdf() has them. MAPS (bits:
+// shading/surface.h (default BRDF), with KHR_materials_specular's F0 / F90,
+// KHR_materials_clearcoat's lobe and KHR_materials_sheen's lobe over the base
+// as evaluate_brdf() has them (in float; brdf.h takes the sheen in double),
+// and the normals bent as facing_normal() bends them. MAPS (bits:
 // 1 base, 2 metal-rough, 4 rough, 8 metal, 16 normal, 32 occlusion, 64
 // emissive, 128 specular, 256 specular colour, 512 clearcoat, 1024 clearcoat
 // roughness, 2048 clearcoat normal, 4096 sheen colour, 8192 sheen roughness;
-// the sheen's albedo table of brdf.h is t_sheen_E) and LINEAR_OUT (1: linear radiance for
+// the sheen's albedo table of brdf.h is t_sheen_E), SPECULAR, CLEARCOAT and
+// SHEEN (1: the material has the lobe) and LINEAR_OUT (1: linear radiance for
 // the MSAA resolve) are #defined before it.
 const char* kFragmentShader = R"(
 #define HAS(bit) ((MAPS & bit) != 0)
@@ -122,7 +129,6 @@ uniform vec4 u_base_color_factor;
 uniform float u_metallic_factor, u_roughness_factor, u_normal_scale, u_occlusion_strength, u_ior;
 uniform vec3 u_emissive_factor;
 uniform sampler2D t_base, t_mr, t_rough, t_metal, t_normal, t_occlusion, t_emissive;
-uniform int u_specular_ext;     // KHR_materials_specular present
 uniform float u_specular_factor;
 uniform vec3 u_specular_color_factor;
 uniform float u_clearcoat, u_clearcoat_roughness, u_clearcoat_normal_scale;  // u_clearcoat 0: no coat
@@ -140,6 +146,16 @@ const float PI = 3.14159265358979;
 vec3 safe_normalize(vec3 v, vec3 fallback) {
     float len2 = dot(v, v);
     return len2 > 1e-20 ? v / sqrt(len2) : fallback;
+}
+// surface.h's facing_normal(): a normal turned away from the eye is bent
+// towards v until n.v = 1e-4, as render bends the base's and the coat's. At
+// n.v = 0 the G and V terms would black out silhouette pixels that render
+// lights with a grazing specular, coat or sheen (up to 248 levels apart).
+vec3 facing_normal(vec3 n, vec3 v) {
+    float d = dot(n, v);
+    if (!(d < 1e-4)) return n;
+    vec3 b = n + v * (1e-4 - d);
+    return b / sqrt(dot(b, b));
 }
 
 // KHR_materials_sheen's Charlie distribution and visibility (brdf.h).
@@ -168,17 +184,21 @@ void main() {
     if (HAS(32)) occlusion = 1.0 + u_occlusion_strength * (texture(t_occlusion, v_uv).r - 1.0);
     vec3 emissive = u_emissive_factor;
     if (HAS(64)) emissive *= texture(t_emissive, v_uv).rgb;
-
+#if SPECULAR
     float spec = u_specular_factor;
     vec3 spec_color = u_specular_color_factor;
     if (HAS(128)) spec *= texture(t_specular, v_uv).a;
     if (HAS(256)) spec_color *= texture(t_specular_color, v_uv).rgb;
     spec = clamp(spec, 0.0, 1.0);
+#endif
+#if CLEARCOAT
     float cc = u_clearcoat, ccr = u_clearcoat_roughness;
     if (HAS(512)) cc *= texture(t_clearcoat, v_uv).r;
     if (HAS(1024)) ccr *= texture(t_clearcoat_rough, v_uv).g;
     cc = clamp(cc, 0.0, 1.0);
     ccr = clamp(ccr, 0.0, 1.0);
+#endif
+#if SHEEN
     vec3 sheen = u_sheen_color_factor;
     float sr = u_sheen_roughness_factor;
     if (HAS(4096)) sheen *= texture(t_sheen_color, v_uv).rgb;
@@ -186,10 +206,12 @@ void main() {
     sheen = clamp(sheen, 0.0, 1.0);
     float rs = clamp(sr, 0.045, 1.0), as = rs * rs;
     float smax = max(sheen.r, max(sheen.g, sheen.b));
+#endif
 
     vec3 N = safe_normalize(v_normal, vec3(0.0, 0.0, 1.0));
     float flip = gl_FrontFacing ? 1.0 : -1.0;
     vec3 n = N * flip;
+#if CLEARCOAT
     vec3 nc = n;  // the coat's normal: the geometric one unless it has its own map
     if (HAS(2048)) {
         vec3 T = safe_normalize(v_tangent.xyz - N * dot(N, v_tangent.xyz), vec3(0.0));
@@ -202,6 +224,7 @@ void main() {
             nc = safe_normalize(T * nt.x + B * nt.y + N * nt.z, N) * flip;
         }
     }
+#endif
     if (HAS(16)) {
         vec3 T = safe_normalize(v_tangent.xyz - N * dot(N, v_tangent.xyz), vec3(0.0));
         if (dot(T, T) > 0.0) {
@@ -214,23 +237,29 @@ void main() {
         }
     }
     vec3 v = safe_normalize(u_eye - v_position, n);
+    n = facing_normal(n, v);
     float r = clamp(roughness, 0.045, 1.0);
     float alpha = r * r, a2 = alpha * alpha;
     float f0d = (1.0 - u_ior) / (1.0 + u_ior);
+#if SPECULAR
+    vec3 F0 = mix(min(vec3(f0d * f0d) * spec_color, vec3(1.0)) * spec, base.rgb, metallic);
+    float F90 = mix(spec, 1.0, metallic);
+#else
     vec3 F0 = mix(vec3(f0d * f0d), base.rgb, metallic);
-    float F90 = 1.0;
-    if (u_specular_ext != 0) {
-        F0 = mix(min(vec3(f0d * f0d) * spec_color, vec3(1.0)) * spec, base.rgb, metallic);
-        F90 = mix(spec, 1.0, metallic);
-    }
+    const float F90 = 1.0;
+#endif
     float k = (r + 1.0) * (r + 1.0) / 8.0;
     float NoV = clamp(dot(n, v), 0.0, 1.0);
+    vec3 Lo = emissive;
+#if CLEARCOAT
     // The coat: F_coat at n_c.v weights its lobe and attenuates what lies beneath.
+    nc = facing_normal(nc, v);
     float rc = clamp(ccr, 0.045, 1.0), ac2 = rc * rc * rc * rc, kc = (rc + 1.0) * (rc + 1.0) / 8.0;
     float NcV = clamp(dot(nc, v), 0.0, 1.0);
     float Fc = 0.04 + 0.96 * pow(1.0 - NcV, 5.0);
     float atten = cc > 0.0 ? 1.0 - cc * Fc : 1.0;
-    vec3 Lo = emissive * atten;
+    Lo *= atten;
+#endif
     for (int i = 0; i < u_light_count; ++i) {
         vec3 l, radiance;
         if (u_light[i].w == 0.0) { l = u_light[i].xyz; radiance = u_light_radiance[i]; }
@@ -254,6 +283,7 @@ void main() {
         vec3 specular = D * G * F / (4.0 * max(NoV, 1e-4) * max(NoL, 1e-4));
         vec3 kd = (1.0 - F) * (1.0 - metallic);
         vec3 f = kd * base.rgb / PI + specular;
+#if SHEEN
         if (smax > 0.0) {  // the sheen over the base, which keeps what it leaves
             float Ds = (2.0 + 1.0 / as) * pow(max(1.0 - NoH * NoH, 0.0), 0.5 / as) / (2.0 * PI);
             float den = (1.0 + sheen_lambda(NoV, as) + sheen_lambda(NoL, as)) * (4.0 * NoV * NoL);
@@ -261,6 +291,8 @@ void main() {
             float scaling = min(1.0 - smax * sheen_E(NoV, rs), 1.0 - smax * sheen_E(NoL, rs));
             f = f * scaling + sheen * (Ds * Vs);
         }
+#endif
+#if CLEARCOAT
         Lo += f * atten * radiance * NoL;
         if (cc > 0.0) {
             float NcL = clamp(dot(nc, l), 0.0, 1.0), NcH = clamp(dot(nc, h), 0.0, 1.0);
@@ -269,6 +301,9 @@ void main() {
             float Gc = (NcV / (NcV * (1.0 - kc) + kc)) * (NcL / (NcL * (1.0 - kc) + kc));
             Lo += cc * Fc * Dc * Gc / (4.0 * max(NcV, 1e-4) * max(NcL, 1e-4)) * radiance * NcL;
         }
+#else
+        Lo += f * radiance * NoL;
+#endif
     }
     Lo += u_ambient * base.rgb * occlusion;
     o_color = LINEAR_OUT != 0 ? vec4(Lo, 1.0) : vec4(display(Lo), 1.0);
@@ -473,6 +508,7 @@ int main(int argc, char** argv) {
         return t;
     };
     constexpr int kUnits = 14;  // the seven core maps, then the specular, clearcoat and sheen ones
+    constexpr int kSpecularBit = 1 << kUnits, kClearcoatBit = 2 << kUnits, kSheenBit = 4 << kUnits;
     struct GpuMaterial {
         const Material* m;
         GLuint tex[kUnits];
@@ -488,6 +524,13 @@ int main(int argc, char** argv) {
                           texture(m.clearcoat_normal_texture, false), texture(m.sheen_color_texture, true),
                           texture(m.sheen_roughness_texture, false)}};
         for (int i = 0; i < kUnits; ++i) g.maps |= g.tex[i] ? 1 << i : 0;
+        // The lobes the material has, as program bits above the maps' (render
+        // shades a coat of factor 0 or a black sheen as no coat or sheen).
+        const bool sheen = m.has_sheen && (m.sheen_color_factor.x > 0.0f || m.sheen_color_factor.y > 0.0f ||
+                                           m.sheen_color_factor.z > 0.0f);
+        if (m.has_specular) g.maps |= kSpecularBit;
+        if (m.has_clearcoat && m.clearcoat_factor > 0.0f) g.maps |= kClearcoatBit;
+        if (sheen) g.maps |= kSheenBit;
         materials.push_back(g);
     }
     // The sheen's albedo table (brdf.h), bilinear between its texel centres, on the unit after the maps.
@@ -509,7 +552,7 @@ int main(int argc, char** argv) {
     std::vector<GpuMesh> meshes;
     for (const Mesh& m : scene.meshes) meshes.push_back(upload(m));
 
-    // One program per combination of maps, with its uniform locations.
+    // One program per combination of maps and lobes, with its uniform locations.
     const int tonemap = opt.effective_tonemap() == ToneMap::Aces ? 1 : opt.effective_tonemap() == ToneMap::Neutral ? 2 : 0;
     const bool msaa = opt.msaa > 1;
     const glm::mat4 vp = camera.view_projection(aspect);
@@ -518,7 +561,7 @@ int main(int argc, char** argv) {
         GLuint id = 0;
         GLint base_color_factor, metallic_factor, roughness_factor, normal_scale, occlusion_strength, ior,
             emissive_factor;
-        GLint specular_ext, specular_factor, specular_color_factor, clearcoat, clearcoat_roughness,
+        GLint specular_factor, specular_color_factor, clearcoat, clearcoat_roughness,
             clearcoat_normal_scale, sheen_color_factor, sheen_roughness_factor;
     };
     std::map<int, Program> programs;
@@ -526,7 +569,9 @@ int main(int argc, char** argv) {
         auto it = programs.find(maps);
         if (it != programs.end()) return it->second;
         const std::string defines =
-            "#define MAPS " + std::to_string(maps) + "\n#define LINEAR_OUT " + (msaa ? "1" : "0") + "\n";
+            "#define MAPS " + std::to_string(maps & (kSpecularBit - 1)) + "\n#define LINEAR_OUT " +
+            (msaa ? "1" : "0") + "\n#define SPECULAR " + (maps & kSpecularBit ? "1" : "0") + "\n#define CLEARCOAT " +
+            (maps & kClearcoatBit ? "1" : "0") + "\n#define SHEEN " + (maps & kSheenBit ? "1" : "0") + "\n";
         Program p;
         p.id = link_program(kVertexShader, program_source(tonemap, defines, kFragmentShader).c_str());
         glUseProgram(p.id);
@@ -555,7 +600,6 @@ int main(int argc, char** argv) {
         p.occlusion_strength = loc(p.id, "u_occlusion_strength");
         p.ior = loc(p.id, "u_ior");
         p.emissive_factor = loc(p.id, "u_emissive_factor");
-        p.specular_ext = loc(p.id, "u_specular_ext");
         p.specular_factor = loc(p.id, "u_specular_factor");
         p.specular_color_factor = loc(p.id, "u_specular_color_factor");
         p.clearcoat = loc(p.id, "u_clearcoat");
@@ -637,7 +681,6 @@ int main(int argc, char** argv) {
             glUniform1f(p.occlusion_strength, m.occlusion_strength);
             glUniform1f(p.ior, m.ior);
             glUniform3fv(p.emissive_factor, 1, &m.emissive_factor[0]);
-            glUniform1i(p.specular_ext, m.has_specular ? 1 : 0);
             glUniform1f(p.specular_factor, m.specular_factor);
             glUniform3fv(p.specular_color_factor, 1, &m.specular_color_factor[0]);
             glUniform1f(p.clearcoat, m.has_clearcoat ? m.clearcoat_factor : 0.0f);
