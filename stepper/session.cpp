@@ -147,26 +147,36 @@ public:
         const std::size_t tile = std::size_t(rec_.tile_of(in.x, in.y));
         const std::vector<BlockRecord>& blocks = rec_.tiles[tile].blocks;
         const std::uint32_t tri = rec_.draws[draw].first_triangle + in.prim_id;
-        std::size_t i = cursor_[tile];
-        while (i > 0 && !(blocks[i - 1].bx == in.x && blocks[i - 1].by == in.y &&
-                          rec_.pieces[blocks[i - 1].piece].triangle == tri && blocks[i - 1].shaded == in.mask))
-            --i;
-        if (i == 0) return fail("a shaded block the recording does not have");
-        const BlockRecord& b = blocks[i - 1];
+        auto same_inputs = [&](const FragmentBlock<NV>& ri) {
+            return !std::memcmp(ri.var, in.var, sizeof in.var) && !std::memcmp(ri.z, in.z, sizeof in.z) &&
+                   ri.mask == in.mask && ri.front_facing == in.front_facing && ri.prim_id == in.prim_id &&
+                   ri.centroid_mask == in.centroid_mask &&
+                   (!in.centroid_mask || !std::memcmp(ri.centre_var, in.centre_var, sizeof in.centre_var));
+        };
+        // The pieces of a clipped triangle can each shade the same lanes of a
+        // block (a pixel on their shared edge, its samples split between them):
+        // the block is the latest of those whose replay gives the rasterizer's
+        // inputs, and the latest of them all if none does.
+        std::size_t latest = 0;
+        const BlockRecord* found = nullptr;
         ReplayedBlock rb;
-        replay_block(s_, rec_, b, rb);
+        for (std::size_t i = cursor_[tile]; i > 0 && !found; --i) {
+            const BlockRecord& c = blocks[i - 1];
+            if (!(c.bx == in.x && c.by == in.y && rec_.pieces[c.piece].triangle == tri && c.shaded == in.mask)) continue;
+            if (!latest) latest = i;
+            replay_block(s_, rec_, c, rb);
+            if (rb.varyings == NV && same_inputs(program_block<NV>(rb))) found = &c;
+        }
+        if (!latest) return fail("a shaded block the recording does not have");
+        if (!found) replay_block(s_, rec_, blocks[latest - 1], rb);
+        const BlockRecord& b = found ? *found : blocks[latest - 1];
         ++shaded_blocks_;
         const std::string where = "block " + std::to_string(in.x) + "," + std::to_string(in.y) + " of tri " +
                                   std::to_string(rec_.pieces[b.piece].triangle);
         if (live != b.live) fail(where + ": written lanes differ");
         if (rb.varyings != NV) return fail(where + ": replayed with " + std::to_string(rb.varyings) + " varyings, drawn with " +
                                            std::to_string(NV));
-        const FragmentBlock<NV>& ri = program_block<NV>(rb);
-        if (std::memcmp(ri.var, in.var, sizeof in.var) || std::memcmp(ri.z, in.z, sizeof in.z) ||
-            ri.mask != in.mask || ri.front_facing != in.front_facing || ri.prim_id != in.prim_id ||
-            ri.centroid_mask != in.centroid_mask ||
-            (in.centroid_mask && std::memcmp(ri.centre_var, in.centre_var, sizeof in.centre_var)))
-            fail(where + ": recomputed varyings or depths differ from the rasterizer's");
+        if (!found) fail(where + ": recomputed varyings or depths differ from the rasterizer's");
         centroid_lanes_ += std::uint64_t(__builtin_popcount(in.centroid_mask));
         const BoundMaterial& bm = material_of(s_, rec_, rec_.pieces[b.piece].triangle);
         for (std::uint32_t m = live; m; m &= m - 1) {
