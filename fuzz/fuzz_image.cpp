@@ -1,6 +1,7 @@
 // libFuzzer harness: image decoding (scene/image.cpp: our PNG decoder and
-// libpng, stb_image behind the HDR and JPEG guards), one build per format:
-// PRAST_FUZZ_PNG, PRAST_FUZZ_JPEG or PRAST_FUZZ_HDR (fuzz/targets.h: run_image).
+// libpng, stb_image behind the HDR and JPEG guards, libwebp), one build per
+// format: PRAST_FUZZ_PNG, PRAST_FUZZ_JPEG, PRAST_FUZZ_HDR or PRAST_FUZZ_WEBP
+// (fuzz/targets.h: run_image).
 #include "fuzz/targets.h"
 
 #if defined(PRAST_FUZZ_PNG)
@@ -9,8 +10,10 @@ constexpr prast::fuzz::Target kTarget = prast::fuzz::Target::Png;
 constexpr prast::fuzz::Target kTarget = prast::fuzz::Target::Jpeg;
 #elif defined(PRAST_FUZZ_HDR)
 constexpr prast::fuzz::Target kTarget = prast::fuzz::Target::Hdr;
+#elif defined(PRAST_FUZZ_WEBP)
+constexpr prast::fuzz::Target kTarget = prast::fuzz::Target::Webp;
 #else
-#error "define PRAST_FUZZ_PNG, PRAST_FUZZ_JPEG or PRAST_FUZZ_HDR"
+#error "define PRAST_FUZZ_PNG, PRAST_FUZZ_JPEG, PRAST_FUZZ_HDR or PRAST_FUZZ_WEBP"
 #endif
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

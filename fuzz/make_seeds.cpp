@@ -1,9 +1,14 @@
 // Writes the seed corpora of the harnesses: `fuzz_make_seeds OUT` fills
-// OUT/obj, OUT/gltf, OUT/png, OUT/jpeg, OUT/hdr, OUT/cli and OUT/step with small valid
+// OUT/obj, OUT/gltf, OUT/png, OUT/jpeg, OUT/hdr, OUT/webp, OUT/meshopt, OUT/cli and OUT/step with small valid
 // inputs that reach every branch the fuzzers should start from (materials
 // and maps, every glTF accessor kind, each image channel count, the HDR
-// run-length and flat paths, every render flag). Made by the project, so no
-// file of unknown origin is needed; scripts/fuzz.sh runs it.
+// run-length and flat paths, every render flag, compressed glTF data:
+// EXT_meshopt_compression in each mode and filter, KHR_draco_mesh_compression,
+// EXT_texture_webp, and OUT/webp). Made by the project, so no file of unknown
+// origin is needed; scripts/fuzz.sh runs it. The compressed seeds are encoded
+// here by libdraco's and libwebp's encoders (in the static libraries render
+// links) and by libmeshoptimizer's (shared, found by fuzz/CMakeLists.txt;
+// without it the meshopt seeds are left out).
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -13,7 +18,15 @@
 #include <string>
 #include <vector>
 
+#include <draco/compression/encode.h>
+#include <draco/mesh/mesh.h>
+#include <nlohmann/json.hpp>
 #include <stb_image_write.h>
+#include <webp/encode.h>
+
+#if defined(PRAST_HAVE_MESHOPT_ENCODER)
+#include <meshoptimizer.h>
+#endif
 
 #include "fuzz/png_craft.h"
 #include "fuzz/targets.h"
@@ -408,6 +421,436 @@ void gltf_seeds() {
         R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})");
 }
 
+// ---- Compressed glTF data (EXT_meshopt_compression, KHR_draco_mesh_compression, EXT_texture_webp)
+
+using json = nlohmann::json;
+
+std::string data_uri(const std::string& type, const std::string& bytes) {
+    return "data:" + type + ";base64," + base64(bytes);
+}
+
+// A .glb of `doc` with `bin` as its BIN chunk (buffer 0).
+std::string make_glb(const json& doc, std::string bin) {
+    std::string text = doc.dump();
+    while (text.size() % 4) text += ' ';
+    while (bin.size() % 4) bin += '\0';
+    std::string out = "glTF";
+    const auto u32 = [&](std::size_t v) {
+        for (int k = 0; k < 4; ++k) out += char((v >> (8 * k)) & 0xff);
+    };
+    u32(2);
+    u32(12 + 8 + text.size() + 8 + bin.size());
+    u32(text.size());
+    u32(0x4E4F534Au);
+    out += text;
+    u32(bin.size());
+    u32(0x004E4942u);
+    out += bin;
+    return out;
+}
+
+template <class T> std::string raw_bytes(const std::vector<T>& v) {
+    return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+}
+
+// A bent 4x4 grid (16 vertices, 18 triangles): small, so that the fuzzer
+// runs it fast, with every attribute the seeds compress.
+struct SeedGrid {
+    static constexpr int kSide = 4;
+    std::vector<float> pos, nrm, tan, uv;
+    std::vector<std::uint32_t> idx;
+    SeedGrid() {
+        for (int y = 0; y < kSide; ++y)
+            for (int x = 0; x < kSide; ++x) {
+                const float u = float(x) / (kSide - 1), v = float(y) / (kSide - 1);
+                pos.insert(pos.end(), {2.0f * u - 1.0f, 1.0f - 2.0f * v, 0.3f * std::sin(3.0f * u) * std::cos(2.0f * v)});
+                const float nx = -0.9f * std::cos(3.0f * u) * std::cos(2.0f * v), ny = 0.6f * std::sin(3.0f * u);
+                const float len = std::sqrt(nx * nx + ny * ny + 1.0f);
+                nrm.insert(nrm.end(), {nx / len, ny / len, 1.0f / len});
+                tan.insert(tan.end(), {1.0f / len, 0.0f, -nx / len, 1.0f});
+                uv.insert(uv.end(), {u, v});
+            }
+        for (int y = 0; y + 1 < kSide; ++y)
+            for (int x = 0; x + 1 < kSide; ++x) {
+                const std::uint32_t a = std::uint32_t(y * kSide + x), b = a + 1, c = a + kSide, d = c + 1;
+                idx.insert(idx.end(), {a, c, b, b, c, d});
+            }
+    }
+    std::size_t vertices() const { return pos.size() / 3; }
+};
+
+#if defined(PRAST_HAVE_MESHOPT_ENCODER)
+// One bufferView: its decoded bytes, the accessor reading them, and the
+// stream libmeshoptimizer encodes them to.
+struct MeshoptView {
+    std::string raw, packed;
+    std::size_t stride = 0, count = 0;
+    std::string mode = "ATTRIBUTES", filter = "NONE";
+    json accessor;
+};
+
+MeshoptView meshopt_attributes(const std::string& raw, std::size_t stride, const std::string& filter, json accessor) {
+    MeshoptView v;
+    v.raw = raw;
+    v.stride = stride;
+    v.count = raw.size() / stride;
+    v.filter = filter;
+    v.accessor = std::move(accessor);
+    v.accessor["count"] = v.count;
+    std::vector<unsigned char> out(meshopt_encodeVertexBufferBound(v.count, stride));
+    out.resize(meshopt_encodeVertexBuffer(out.data(), out.size(), raw.data(), v.count, stride));
+    v.packed.assign(out.begin(), out.end());
+    return v;
+}
+
+MeshoptView meshopt_indices(const std::vector<std::uint32_t>& idx, std::size_t stride, bool triangles, std::size_t vertices) {
+    MeshoptView v;
+    v.stride = stride;
+    v.count = idx.size();
+    v.mode = triangles ? "TRIANGLES" : "INDICES";
+    for (std::uint32_t i : idx) v.raw.append(reinterpret_cast<const char*>(&i), stride);  // little-endian: the low bytes
+    v.accessor = {{"componentType", stride == 2 ? 5123 : 5125}, {"type", "SCALAR"}, {"count", v.count}};
+    std::vector<unsigned char> out(triangles ? meshopt_encodeIndexBufferBound(idx.size(), vertices)
+                                             : meshopt_encodeIndexSequenceBound(idx.size(), vertices));
+    out.resize(triangles ? meshopt_encodeIndexBuffer(out.data(), out.size(), idx.data(), idx.size())
+                         : meshopt_encodeIndexSequence(out.data(), out.size(), idx.data(), idx.size()));
+    v.packed.assign(out.begin(), out.end());
+    return v;
+}
+
+// Every mode and filter: POSITION (ATTRIBUTES), NORMAL as normalized bytes
+// (OCTAHEDRAL, stride 4), TANGENT as normalized shorts (OCTAHEDRAL, stride
+// 8), TEXCOORD_0 (EXPONENTIAL), indices as TRIANGLES (16 and 32 bits) and
+// INDICES; an animation's times (ATTRIBUTES, stride 4), rotations
+// (QUATERNION) and translations (EXPONENTIAL).
+std::vector<MeshoptView> meshopt_views() {
+    const SeedGrid g;
+    const std::size_t n = g.vertices();
+    std::vector<MeshoptView> views;
+    views.push_back(meshopt_attributes(raw_bytes(g.pos), 12, "NONE",
+                                       {{"componentType", 5126}, {"type", "VEC3"}, {"min", {-1, -1, -1}}, {"max", {1, 1, 1}}}));
+    std::vector<float> nrm4;
+    for (std::size_t i = 0; i < n; ++i) nrm4.insert(nrm4.end(), {g.nrm[3 * i], g.nrm[3 * i + 1], g.nrm[3 * i + 2], 0.0f});
+    std::string oct8(n * 4, '\0'), oct16(n * 8, '\0');
+    meshopt_encodeFilterOct(oct8.data(), n, 4, 8, nrm4.data());
+    meshopt_encodeFilterOct(oct16.data(), n, 8, 12, g.tan.data());
+    views.push_back(meshopt_attributes(oct8, 4, "OCTAHEDRAL", {{"componentType", 5120}, {"normalized", true}, {"type", "VEC3"}}));
+    views.push_back(meshopt_attributes(oct16, 8, "OCTAHEDRAL", {{"componentType", 5122}, {"normalized", true}, {"type", "VEC4"}}));
+    std::string exp_uv(n * 8, '\0');
+    meshopt_encodeFilterExp(exp_uv.data(), n, 8, 15, g.uv.data());
+    views.push_back(meshopt_attributes(exp_uv, 8, "EXPONENTIAL", {{"componentType", 5126}, {"type", "VEC2"}}));
+    views.push_back(meshopt_indices(g.idx, 2, true, n));
+    views.push_back(meshopt_indices(g.idx, 4, false, n));
+    views.push_back(meshopt_indices(g.idx, 4, true, n));
+    const std::vector<float> times = {0.0f, 0.5f, 1.0f, 2.0f};
+    views.push_back(meshopt_attributes(raw_bytes(times), 4, "NONE",
+                                       {{"componentType", 5126}, {"type", "SCALAR"}, {"min", {0}}, {"max", {2}}}));
+    const float h = 0.70710678f;
+    const std::vector<float> quats = {0, 0, 0, 1, 0, h, 0, h, h, 0, 0, h, 0.5f, 0.5f, 0.5f, 0.5f};
+    std::string quat(4 * 8, '\0');
+    meshopt_encodeFilterQuat(quat.data(), 4, 8, 12, quats.data());
+    views.push_back(meshopt_attributes(quat, 8, "QUATERNION", {{"componentType", 5122}, {"normalized", true}, {"type", "VEC4"}}));
+    const std::vector<float> moves = {0, 0, 0, 1.5f, -2, 0.25f, 1e-3f, 4, 0, -3, 0, 1};
+    std::string exp_t(4 * 12, '\0');
+    meshopt_encodeFilterExp(exp_t.data(), 4, 12, 18, moves.data());
+    views.push_back(meshopt_attributes(exp_t, 12, "EXPONENTIAL", {{"componentType", 5126}, {"type", "VEC3"}}));
+    return views;
+}
+
+enum class MeshoptLayout { GltfFallback, GlbGltfpack, GltfWithData };
+
+// The model of meshopt_views() in one of three layouts: a .gltf whose buffer
+// 0 is a uri-less fallback (the streams in buffer 1, a data URI); gltfpack's
+// .glb (the streams in the BIN chunk, buffer 1 the uri-less fallback); a
+// .gltf whose fallback holds the uncompressed data, under
+// KHR_meshopt_compression, with the stream of view `broken` given a bad
+// header byte (the loader warns and reads the fallback).
+std::string meshopt_model(const std::vector<MeshoptView>& views, MeshoptLayout layout, int broken = -1) {
+    const char* ext = layout == MeshoptLayout::GltfWithData ? "KHR_meshopt_compression" : "EXT_meshopt_compression";
+    const int raw_buffer = layout == MeshoptLayout::GlbGltfpack ? 1 : 0, packed_buffer = 1 - raw_buffer;
+    std::string raw, packed;
+    json bviews = json::array(), accessors = json::array();
+    for (std::size_t i = 0; i < views.size(); ++i) {
+        const MeshoptView& v = views[i];
+        while (raw.size() % 4) raw += '\0';
+        while (packed.size() % 4) packed += '\0';
+        json bv = {{"buffer", raw_buffer}, {"byteOffset", raw.size()}, {"byteLength", v.raw.size()}};
+        if (v.mode == "ATTRIBUTES" && v.stride % 4 == 0 && v.accessor["type"] != "SCALAR") bv["byteStride"] = v.stride;
+        json e = {{"buffer", packed_buffer}, {"byteOffset", packed.size()}, {"byteLength", v.packed.size()},
+                  {"byteStride", v.stride},  {"count", v.count},           {"mode", v.mode}};
+        if (v.filter != "NONE") e["filter"] = v.filter;
+        bv["extensions"][ext] = e;
+        bviews.push_back(bv);
+        json a = v.accessor;
+        a["bufferView"] = i;
+        accessors.push_back(a);
+        raw += v.raw;
+        std::string p = v.packed;
+        if (int(i) == broken) p[0] = '\x42';
+        packed += p;
+    }
+    json doc = {{"asset", {{"version", "2.0"}}}, {"extensionsUsed", {ext, "KHR_mesh_quantization"}},
+                {"extensionsRequired", {ext, "KHR_mesh_quantization"}}};
+    doc["bufferViews"] = bviews;
+    doc["accessors"] = accessors;
+    doc["meshes"] = json::array({{{"primitives", json::array({
+                                      {{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TANGENT", 2}, {"TEXCOORD_0", 3}}},
+                                       {"indices", 4}},
+                                      {{"attributes", {{"POSITION", 0}}}, {"indices", 5}},
+                                      {{"attributes", {{"POSITION", 0}}}, {"indices", 6}, {"mode", 4}},
+                                  })}}});
+    doc["nodes"] = json::array({{{"mesh", 0}}});
+    doc["scenes"] = json::array({{{"nodes", {0}}}});
+    doc["scene"] = 0;
+    doc["animations"] = json::array({{{"samplers", json::array({{{"input", 7}, {"output", 8}}, {{"input", 7}, {"output", 9}}})},
+                                      {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "rotation"}}}},
+                                                                {{"sampler", 1}, {"target", {{"node", 0}, {"path", "translation"}}}}})}}});
+    const json fallback = {{"byteLength", raw.size()}, {"extensions", {{ext, {{"fallback", true}}}}}};
+    switch (layout) {
+    case MeshoptLayout::GltfFallback:
+        doc["buffers"] = json::array({fallback, {{"byteLength", packed.size()}, {"uri", data_uri("application/octet-stream", packed)}}});
+        return doc.dump();
+    case MeshoptLayout::GltfWithData:
+        doc["buffers"] = json::array({{{"byteLength", raw.size()}, {"uri", data_uri("application/octet-stream", raw)}},
+                                      {{"byteLength", packed.size()}, {"uri", data_uri("application/octet-stream", packed)}}});
+        return doc.dump();
+    case MeshoptLayout::GlbGltfpack:
+        while (packed.size() % 4) packed += '\0';
+        doc["buffers"] = json::array({{{"byteLength", packed.size()}}, fallback});
+        return make_glb(doc, packed);
+    }
+    return "";
+}
+#endif
+
+// The grid as a Draco stream (libdraco's encoder): `method` sequential or
+// edgebreaker, quantized or lossless; the ids of POSITION, NORMAL, TEXCOORD_0.
+std::string draco_stream(int method, bool quantize, int ids[3]) {
+    const SeedGrid g;
+    const std::size_t n = g.vertices();
+    draco::Mesh mesh;
+    mesh.set_num_points(std::uint32_t(n));
+    const std::vector<float>* data[3] = {&g.pos, &g.nrm, &g.uv};
+    const draco::GeometryAttribute::Type types[3] = {draco::GeometryAttribute::POSITION, draco::GeometryAttribute::NORMAL,
+                                                     draco::GeometryAttribute::TEX_COORD};
+    for (int a = 0; a < 3; ++a) {
+        const int per = a == 2 ? 2 : 3;
+        draco::GeometryAttribute ga;
+        ga.Init(types[a], nullptr, std::uint8_t(per), draco::DT_FLOAT32, false, sizeof(float) * std::size_t(per), 0);
+        const int id = mesh.AddAttribute(ga, true, std::uint32_t(n));
+        for (std::size_t i = 0; i < n; ++i)
+            mesh.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(std::uint32_t(i)), &(*data[a])[i * std::size_t(per)]);
+        ids[a] = int(mesh.attribute(id)->unique_id());
+    }
+    for (std::size_t t = 0; t < g.idx.size(); t += 3)
+        mesh.AddFace({draco::PointIndex(g.idx[t]), draco::PointIndex(g.idx[t + 1]), draco::PointIndex(g.idx[t + 2])});
+    draco::Encoder encoder;
+    encoder.SetEncodingMethod(method);
+    if (quantize) {
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, 11);
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, 8);
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD, 10);
+        encoder.SetSpeedOptions(5, 5);
+    }
+    draco::EncoderBuffer out;
+    if (!encoder.EncodeMeshToBuffer(mesh, &out).ok()) {
+        std::fprintf(stderr, "fuzz_make_seeds: libdraco could not encode the grid\n");
+        std::exit(1);
+    }
+    return std::string(out.data(), out.size());
+}
+
+// A Draco primitive, and a second one that also has uncompressed accessors
+// (its fallback: the stream given a wrong face count, so the loader warns
+// and reads them). `glb`: the stream in the BIN chunk.
+std::string draco_model(const std::string& stream, const int ids[3], bool glb) {
+    const SeedGrid g;
+    const std::size_t n = g.vertices();
+    std::vector<std::uint16_t> idx16(g.idx.begin(), g.idx.end());
+    std::string bin = stream;
+    while (bin.size() % 4) bin += '\0';
+    const std::size_t raw_at = bin.size();
+    bin += raw_bytes(g.pos) + raw_bytes(g.nrm) + raw_bytes(g.uv) + raw_bytes(idx16);
+    std::string other = stream;
+    // One count made wrong: sequential, the faces (byte 11); edgebreaker, the
+    // vertices (byte 12, after the traversal type), one more than POSITION's.
+    const std::size_t count_at = stream[8] == 1 ? 12 : 11;
+    other[count_at] = char(other[count_at] ^ 1);
+    while (bin.size() % 4) bin += '\0';
+    const std::size_t other_at = bin.size();
+    bin += other;
+    json doc = {{"asset", {{"version", "2.0"}}},
+                {"extensionsUsed", {"KHR_draco_mesh_compression"}},
+                {"extensionsRequired", {"KHR_draco_mesh_compression"}}};
+    doc["buffers"] = json::array({glb ? json{{"byteLength", bin.size()}}
+                                      : json{{"byteLength", bin.size()}, {"uri", data_uri("application/octet-stream", bin)}}});
+    const std::size_t p = n * 12, q = n * 24, r = n * 32;
+    doc["bufferViews"] = json::array({{{"buffer", 0}, {"byteLength", stream.size()}},
+                                      {{"buffer", 0}, {"byteOffset", raw_at}, {"byteLength", p}},
+                                      {{"buffer", 0}, {"byteOffset", raw_at + p}, {"byteLength", q - p}},
+                                      {{"buffer", 0}, {"byteOffset", raw_at + q}, {"byteLength", r - q}},
+                                      {{"buffer", 0}, {"byteOffset", raw_at + r}, {"byteLength", idx16.size() * 2}},
+                                      {{"buffer", 0}, {"byteOffset", other_at}, {"byteLength", other.size()}}});
+    const json bounds_min = {-1, -1, -1}, bounds_max = {1, 1, 1};
+    doc["accessors"] = json::array({
+        {{"componentType", 5126}, {"type", "VEC3"}, {"count", n}, {"min", bounds_min}, {"max", bounds_max}},
+        {{"componentType", 5126}, {"type", "VEC3"}, {"count", n}},
+        {{"componentType", 5126}, {"type", "VEC2"}, {"count", n}},
+        {{"componentType", 5123}, {"type", "SCALAR"}, {"count", g.idx.size()}},
+        {{"bufferView", 1}, {"componentType", 5126}, {"type", "VEC3"}, {"count", n}, {"min", bounds_min}, {"max", bounds_max}},
+        {{"bufferView", 2}, {"componentType", 5126}, {"type", "VEC3"}, {"count", n}},
+        {{"bufferView", 3}, {"componentType", 5126}, {"type", "VEC2"}, {"count", n}},
+        {{"bufferView", 4}, {"componentType", 5123}, {"type", "SCALAR"}, {"count", g.idx.size()}},
+    });
+    const json names = {{"POSITION", ids[0]}, {"NORMAL", ids[1]}, {"TEXCOORD_0", ids[2]}};
+    doc["meshes"] = json::array({{{"primitives", json::array({
+        {{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}}}, {"indices", 3},
+         {"extensions", {{"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", names}}}}}},
+        {{"attributes", {{"POSITION", 4}, {"NORMAL", 5}, {"TEXCOORD_0", 6}}}, {"indices", 7}, {"mode", 4},
+         {"extensions", {{"KHR_draco_mesh_compression", {{"bufferView", 5}, {"attributes", names}}}}}},
+    })}}});
+    doc["nodes"] = json::array({{{"mesh", 0}}, {{"mesh", 0}, {"translation", {0, 0, -1}}}});
+    doc["scenes"] = json::array({{{"nodes", {0, 1}}}});
+    doc["scene"] = 0;
+    return glb ? make_glb(doc, bin) : doc.dump();
+}
+
+// A pattern with some structure (edges and a gradient) for the WebP encoders.
+std::vector<std::uint8_t> webp_pattern(int w, int h, int channels) {
+    std::vector<std::uint8_t> px(std::size_t(w) * std::size_t(h) * std::size_t(channels));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < channels; ++c)
+                px[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * std::size_t(channels) + std::size_t(c)] =
+                    std::uint8_t(c == 3 ? 40 + (x * 29 + y * 7) % 200 : ((x / 2 + y) % 3) * 90 + c * 20 + x);
+    return px;
+}
+
+// Lossless and lossy, each without and with alpha (lossy alpha is VP8X with
+// an ALPH chunk), small and odd-sized.
+std::vector<std::pair<std::string, std::string>> webp_files() {
+    struct Kind {
+        const char* name;
+        int w, h, channels;
+        bool lossless;
+    };
+    const Kind kinds[] = {{"lossless-rgb", 7, 5, 3, true}, {"lossless-rgba", 6, 4, 4, true},
+                          {"lossy-rgb", 9, 9, 3, false},   {"lossy-rgba", 8, 6, 4, false},
+                          {"lossless-1x1", 1, 1, 3, true}, {"lossy-33x17", 33, 17, 3, false}};
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const Kind& k : kinds) {
+        const std::vector<std::uint8_t> px = webp_pattern(k.w, k.h, k.channels);
+        std::uint8_t* out = nullptr;
+        const int stride = k.w * k.channels;
+        std::size_t n = 0;
+        if (k.lossless)
+            n = k.channels == 4 ? WebPEncodeLosslessRGBA(px.data(), k.w, k.h, stride, &out)
+                                : WebPEncodeLosslessRGB(px.data(), k.w, k.h, stride, &out);
+        else
+            n = k.channels == 4 ? WebPEncodeRGBA(px.data(), k.w, k.h, stride, 70.0f, &out)
+                                : WebPEncodeRGB(px.data(), k.w, k.h, stride, 40.0f, &out);
+        if (n == 0) {
+            std::fprintf(stderr, "fuzz_make_seeds: libwebp could not encode %s\n", k.name);
+            std::exit(1);
+        }
+        files.emplace_back(k.name, std::string(reinterpret_cast<const char*>(out), n));
+        WebPFree(out);
+    }
+    return files;
+}
+
+// EXT_texture_webp textures whose images the loader decodes (a
+// specular-glossiness material is converted texel by texel at load), with
+// PNG fallbacks: `glb` puts the WebPs in bufferViews (mimeType image/webp,
+// as gltfpack does), else in data URIs.
+std::string webp_model(const std::vector<std::pair<std::string, std::string>>& webps, bool glb) {
+    json doc = {{"asset", {{"version", "2.0"}}},
+                {"extensionsUsed", {"EXT_texture_webp", "KHR_materials_pbrSpecularGlossiness"}},
+                {"extensionsRequired", {"EXT_texture_webp"}}};
+    std::string bin;
+    auto f32 = [&](float v) { bin.append(reinterpret_cast<const char*>(&v), 4); };
+    for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) f32(v);
+    for (float v : {0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) f32(v);
+    json views = json::array({{{"buffer", 0}, {"byteLength", 36}}, {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 24}}});
+    json images = json::array({{{"uri", data_uri("image/png", prast::fuzz::tiny_png())}}});
+    json textures = json::array();
+    for (const auto& [name, bytes] : webps) {
+        (void)name;
+        if (glb) {
+            while (bin.size() % 4) bin += '\0';
+            views.push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes.size()}});
+            bin += bytes;
+            images.push_back({{"bufferView", views.size() - 1}, {"mimeType", "image/webp"}});
+        } else {
+            images.push_back({{"uri", data_uri("image/webp", bytes)}});
+        }
+        textures.push_back({{"source", 0}, {"extensions", {{"EXT_texture_webp", {{"source", images.size() - 1}}}}}});
+    }
+    textures.push_back({{"extensions", {{"EXT_texture_webp", {{"source", 1}}}}}});  // no fallback
+    textures.push_back({{"source", 0}, {"extensions", {{"EXT_texture_webp", {{"source", 99}}}}}});  // out of range
+    doc["bufferViews"] = views;
+    doc["images"] = images;
+    doc["textures"] = textures;
+    doc["buffers"] = json::array({glb ? json{{"byteLength", bin.size()}}
+                                      : json{{"byteLength", bin.size()}, {"uri", data_uri("application/octet-stream", bin)}}});
+    doc["accessors"] = json::array({{{"bufferView", 0}, {"componentType", 5126}, {"type", "VEC3"}, {"count", 3},
+                                     {"min", {0, 0, 0}}, {"max", {1, 1, 0}}},
+                                    {{"bufferView", 1}, {"componentType", 5126}, {"type", "VEC2"}, {"count", 3}}});
+    json materials = json::array(), prims = json::array();
+    const std::size_t t = textures.size();
+    for (std::size_t i = 0; i + 1 < webps.size(); i += 2) {
+        materials.push_back({{"extensions", {{"KHR_materials_pbrSpecularGlossiness",
+                                              {{"diffuseTexture", {{"index", i}}}, {"specularGlossinessTexture", {{"index", i + 1}}},
+                                               {"specularFactor", {1, 0.8, 0.2}}}}}}});
+    }
+    materials.push_back({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", t - 2}}}}},
+                         {"normalTexture", {{"index", t - 1}}}});
+    for (std::size_t m = 0; m < materials.size(); ++m)
+        prims.push_back({{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}}}, {"material", m}});
+    doc["materials"] = materials;
+    doc["meshes"] = json::array({{{"primitives", prims}}});
+    doc["nodes"] = json::array({{{"mesh", 0}}});
+    doc["scenes"] = json::array({{{"nodes", {0}}}});
+    doc["scene"] = 0;
+    return glb ? make_glb(doc, bin) : doc.dump();
+}
+
+void compression_seeds() {
+#if defined(PRAST_HAVE_MESHOPT_ENCODER)
+    meshopt_encodeVertexVersion(0);
+    meshopt_encodeIndexVersion(1);
+    const std::vector<MeshoptView> views = meshopt_views();
+    put("gltf", "meshopt-modes-filters.gltf", meshopt_model(views, MeshoptLayout::GltfFallback));
+    put("gltf", "meshopt-gltfpack.glb", meshopt_model(views, MeshoptLayout::GlbGltfpack));
+    put("gltf", "meshopt-khr-with-data.gltf", meshopt_model(views, MeshoptLayout::GltfWithData, 4));
+    // fuzz_meshopt's seeds: each stream behind its 4-byte prefix (fuzz/fuzz_meshopt.cpp).
+    for (std::size_t i = 0; i < views.size(); ++i) {
+        const MeshoptView& v = views[i];
+        const int mode = v.mode == "TRIANGLES" ? 1 : v.mode == "INDICES" ? 2 : 0;
+        const int filter = v.filter == "OCTAHEDRAL" ? 1 : v.filter == "QUATERNION" ? 2 : v.filter == "EXPONENTIAL" ? 3 : 0;
+        const int stride = mode == 0 ? int(v.stride / 4 - 1) : v.stride == 4 ? 1 : 0;
+        const std::string prefix = {char(mode | filter << 2), char(stride), char(v.count & 0xff), char(v.count >> 8)};
+        put("meshopt", "view" + std::to_string(i) + "-" + v.mode + "-" + v.filter + "-stride" + std::to_string(v.stride),
+            prefix + v.packed);
+    }
+#else
+    std::fprintf(stderr, "fuzz_make_seeds: no libmeshoptimizer (apt-get install libmeshoptimizer-dev): "
+                         "no EXT_meshopt_compression seeds but meshopt-required.gltf\n");
+#endif
+    for (const bool quantize : {false, true}) {
+        int ids[3];
+        const std::string q = quantize ? "-quantized" : "";
+        const std::string seq = draco_stream(draco::MESH_SEQUENTIAL_ENCODING, quantize, ids);
+        put("gltf", "draco-sequential" + q + ".gltf", draco_model(seq, ids, false));
+        const std::string eb = draco_stream(draco::MESH_EDGEBREAKER_ENCODING, quantize, ids);
+        put("gltf", "draco-edgebreaker" + q + ".glb", draco_model(eb, ids, true));
+    }
+    const std::vector<std::pair<std::string, std::string>> webps = webp_files();
+    for (const auto& [name, bytes] : webps) put("webp", name + ".webp", bytes);
+    put("gltf", "webp-textures.glb", webp_model(webps, true));
+    put("gltf", "webp-textures.gltf", webp_model({webps[0], webps[3]}, false));
+}
+
 void cli_seeds() {
     const char* lines[] = {
         "model.glb|-o|out.png|--size|96x64",
@@ -445,6 +888,7 @@ int main(int argc, char** argv) {
     image_seeds();
     obj_seeds();
     gltf_seeds();
+    compression_seeds();
     cli_seeds();
     step_seeds();
     return 0;

@@ -24,7 +24,7 @@
 
 namespace prast::fuzz {
 
-enum class Target { Obj, Gltf, Png, Jpeg, Hdr, Cli };
+enum class Target { Obj, Gltf, Png, Jpeg, Hdr, Cli, Webp };
 
 inline void write_file(const std::string& path, const void* data, std::size_t size) {
     std::FILE* f = std::fopen(path.c_str(), "wb");
@@ -108,14 +108,24 @@ inline void run_gltf(const std::string& dir, const std::uint8_t* data, std::size
 constexpr long long kMaxFuzzTexels = 1 << 22;
 
 // Images: an input without its format's signature gets it in front, so the
-// fuzzer stays on that decoder's path. Returns false when the decoded size
+// fuzzer stays on that decoder's path (WebP: a RIFF header naming WEBP, the
+// chunks being the input). Returns false when the decoded size
 // disagrees with the header (a defect too).
 inline bool run_image(Target t, const std::uint8_t* data, std::size_t size) {
-    const char* sig = t == Target::Png ? "\x89PNG\r\n\x1a\n" : t == Target::Jpeg ? "\xff\xd8\xff" : "#?RADIANCE\n";
-    const std::size_t n = std::strlen(sig);
     ImageSource src;
     src.name = "fuzz";
-    if (!(size >= n && std::memcmp(data, sig, n) == 0)) src.bytes.assign(sig, sig + n);
+    if (t == Target::Webp) {
+        // RIFF, the RIFF size (what follows it), WEBP: 12 bytes.
+        if (!(size >= 12 && std::memcmp(data, "RIFF", 4) == 0 && std::memcmp(data + 8, "WEBP", 4) == 0)) {
+            const std::size_t riff = size + 4;
+            src.bytes = {'R', 'I', 'F', 'F', std::uint8_t(riff), std::uint8_t(riff >> 8), std::uint8_t(riff >> 16),
+                         std::uint8_t(riff >> 24), 'W', 'E', 'B', 'P'};
+        }
+    } else {
+        const char* sig = t == Target::Png ? "\x89PNG\r\n\x1a\n" : t == Target::Jpeg ? "\xff\xd8\xff" : "#?RADIANCE\n";
+        const std::size_t n = std::strlen(sig);
+        if (!(size >= n && std::memcmp(data, sig, n) == 0)) src.bytes.assign(sig, sig + n);
+    }
     src.bytes.insert(src.bytes.end(), data, data + size);
     int w = 0, h = 0;
     if (image_dimensions(src, w, h) && static_cast<long long>(w) * h > kMaxFuzzTexels) return true;

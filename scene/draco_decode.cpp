@@ -36,6 +36,24 @@ int gltf_component(draco::DataType t) {
     }
 }
 
+// libdraco sizes its corner table and vertex arrays from the header's
+// counts before it reads the connectivity (about 24 bytes a face: a 1.4 KB
+// glTF whose edgebreaker stream and accessors claim 44 million faces took
+// 1 GB before libdraco refused it), and an edgebreaker stream codes a very
+// regular mesh in few bits, so the counts are held to the stream's size:
+// above kDracoFreeElements, at most kMaxDracoElementsPerByte faces (and as
+// many vertices) a byte. The densest stream libdraco's encoder wrote in our
+// measurements (valence coding, a flat 3000x3000 grid quantized to 1 bit)
+// holds 1,020 faces a byte; with 11-bit positions such a grid holds 9.
+constexpr std::uint64_t kDracoFreeElements = std::uint64_t(1) << 20;
+constexpr std::uint64_t kMaxDracoElementsPerByte = 4096;
+
+std::string density(const char* what, std::uint64_t claimed, std::size_t size) {
+    if (claimed <= kDracoFreeElements || claimed <= kMaxDracoElementsPerByte * std::uint64_t(size)) return "";
+    return "the Draco stream claims " + std::to_string(claimed) + " " + what + " in only " + std::to_string(size) +
+           " bytes (more than " + std::to_string(kMaxDracoElementsPerByte) + " a byte are refused)";
+}
+
 } // namespace
 
 std::string read_counts(const unsigned char* data, std::size_t size, Counts& counts) {
@@ -65,6 +83,11 @@ std::string read_counts(const unsigned char* data, std::size_t size, Counts& cou
         return "unknown Draco encoding method " + std::to_string(method);
     }
     return "";
+}
+
+std::string check_density(const Counts& counts, std::size_t size) {
+    const std::string why = density("faces", counts.faces, size);
+    return why.empty() ? density("vertices", counts.vertices, size) : why;
 }
 
 std::string decode(const unsigned char* data, std::size_t size, const std::vector<int>& ids, Mesh& out) {

@@ -25,6 +25,12 @@ struct Counts {
 // Draco, a point cloud, another bitstream version, metadata, truncated).
 std::string read_counts(const unsigned char* data, std::size_t size, Counts& counts);
 
+// "" when a stream of `size` bytes can hold `counts`, else why not: above
+// 2^20, more than 4096 faces (or vertices) a byte, far denser than any
+// stream libdraco's encoder writes. libdraco allocates about 24 bytes a face
+// from the header's counts before it reads the connectivity.
+std::string check_density(const Counts& counts, std::size_t size);
+
 // One attribute as the accessor needs it: `components` values of the glTF
 // componentType `component_type` per point, little-endian, tightly packed.
 struct Attribute {

@@ -870,6 +870,8 @@ private:
             why = "the stream has " + std::to_string(counts.vertices) + " vertices, POSITION " + std::to_string(points);
             return false;
         }
+        why = draco_gltf::check_density(counts, bv.byteLength);
+        if (!why.empty()) return false;
         // What the decoded data will take, against the model's decoding budget.
         std::uint64_t bytes = indices.count * 4;
         for (const Wanted& w : wanted) {

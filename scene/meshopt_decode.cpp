@@ -132,7 +132,13 @@ std::string decode_triangles(const unsigned char* src, std::size_t size, std::si
     const unsigned char* data = codes + triangles;
     const unsigned char* const data_end = src + size - kTriangleTail;
     const unsigned char* const codeaux = data_end;
-    std::uint32_t edges[16][2] = {}, vertices[16] = {};
+    // The specification leaves the FIFOs' first contents undefined; they
+    // start as the reference decoder's (every index ~0), so that a stream
+    // reading them decodes to what every other decoder gives (indices the
+    // loader then refuses as out of range) rather than to vertex 0.
+    std::uint32_t edges[16][2], vertices[16];
+    std::fill(&edges[0][0], &edges[0][0] + 32, ~std::uint32_t(0));
+    std::fill(vertices, vertices + 16, ~std::uint32_t(0));
     unsigned edge_at = 0, vertex_at = 0;  // where the next push goes
     std::uint32_t next = 0, last = 0;
     const auto edge = [&](unsigned x, std::uint32_t& a, std::uint32_t& b) {

@@ -4,7 +4,7 @@
 # line and the stepper's command interpreter, each for SECONDS (default 60),
 # one after the other.
 #
-#   scripts/fuzz.sh SECONDS [HARNESS...]     HARNESS: obj gltf png jpeg hdr cli step
+#   scripts/fuzz.sh SECONDS [HARNESS...]     HARNESS: obj gltf meshopt webp png jpeg hdr cli step
 #
 # Builds build-fuzz/ with clang (apt-get install clang libclang-rt-14-dev),
 # writes the project's seed corpora (fuzz/make_seeds.cpp) to build-fuzz/seeds,
@@ -19,7 +19,7 @@ set -e
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
 [ $# -gt 0 ] && shift
-harnesses=${*:-obj gltf png jpeg hdr cli step}
+harnesses=${*:-obj gltf meshopt webp png jpeg hdr cli step}
 out="$PWD/build-fuzz"  # absolute: fuzz_step works in a folder of its own
 export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}"
 if [ ! -f $out/CMakeCache.txt ]; then

@@ -250,6 +250,19 @@ TEST_CASE("meshopt: hand-built streams of each mode decode to their values; bad 
     tt.insert(tt.end(), 16, 0);
     CHECK(meshopt::decode(meshopt::Mode::Triangles, meshopt::Filter::None, tt.data(), tt.size(), 3, 2, to.data())
               .find("truncated") == 0);
+    // A first code reading the FIFOs before anything was pushed (fuzz_meshopt
+    // against libmeshoptimizer): their contents start as the reference
+    // decoder's, every index ~0, not vertex 0. Code 0x00: edge 0 and next;
+    // code 0x1c: edge 1 and vertex 12.
+    for (const unsigned char code : {0x00, 0x1c}) {
+        CAPTURE(int(code));
+        std::vector<unsigned char> fs = {0xe1, code};
+        fs.insert(fs.end(), 16, 0);
+        std::vector<unsigned char> fo(3 * 4);
+        CHECK(meshopt::decode(meshopt::Mode::Triangles, meshopt::Filter::None, fs.data(), fs.size(), 3, 4, fo.data()) == "");
+        const std::uint32_t fifo[3] = {0xffffffffu, 0xffffffffu, code == 0x00 ? 0u : 0xffffffffu};
+        CHECK(std::memcmp(fo.data(), fifo, 12) == 0);
+    }
 
     // Exponential filter: 2^e * m exactly.
     std::vector<unsigned char> ex(8);
@@ -690,6 +703,45 @@ TEST_CASE("KHR_draco_mesh_compression: hostile streams and accessors are one lin
     CHECK(r.err.find("KHR_draco_mesh_compression") != std::string::npos);
     CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
 #endif
+}
+
+TEST_CASE("KHR_draco_mesh_compression: an edgebreaker stream claiming 40 million faces in 3 KB is refused before libdraco") {
+    // libdraco sized its corner table from the claim (about 1 GB) before
+    // refusing the stream; the accessors agree with the claim, so only the
+    // stream's size can tell (scene/draco_decode.h check_density).
+    int ids[3];
+    const std::vector<unsigned char> eb = draco_grid(draco::MESH_EDGEBREAKER_ENCODING, ids);
+    const std::uint32_t faces = 40000000;
+    std::size_t p = 12;  // after the header and the traversal type: vertices, faces, attribute data, symbols
+    const auto skip = [&] {
+        while (eb[p] & 0x80) ++p;
+        ++p;
+    };
+    skip();
+    const std::size_t faces_at = p;
+    skip();
+    const std::size_t attribute_data = p++;
+    skip();
+    std::vector<unsigned char> claim;
+    for (std::uint32_t v = faces; v; v >>= 7) claim.push_back(static_cast<unsigned char>((v & 127) | (v > 127 ? 128 : 0)));
+    std::vector<unsigned char> stream(eb.begin(), eb.begin() + std::ptrdiff_t(faces_at));
+    stream.insert(stream.end(), claim.begin(), claim.end());  // faces
+    stream.push_back(eb[attribute_data]);
+    stream.insert(stream.end(), claim.begin(), claim.end());  // as many symbols (libdraco checks them against the faces)
+    stream.insert(stream.end(), eb.begin() + std::ptrdiff_t(p), eb.end());
+    REQUIRE(stream.size() < 3000);  // the 9x9 grid, lossless: far fewer bytes than 40,000,000 / 4096
+    json doc = draco_model(stream, ids);
+    doc["accessors"][3]["count"] = std::uint64_t(faces) * 3;
+    TempDir dir("draco_dense");
+    write_text(dir.file("dense.gltf"), doc.dump());
+    const std::string err = load_error(dir.file("dense.gltf"));
+    CAPTURE(err);
+    CHECK(err.find("KHR_draco_mesh_compression: the Draco stream claims 40000000 faces in only " +
+                   std::to_string(stream.size()) + " bytes (more than 4096 a byte are refused)") != std::string::npos);
+    CHECK(err.find('\n') == std::string::npos);
+    // The same grid as it was encoded still loads.
+    write_text(dir.file("grid.gltf"), draco_model(eb, ids).dump());
+    CHECK(load_error(dir.file("grid.gltf")) == "");
 }
 
 #endif  // PRAST_HAVE_MESHOPT_ENCODER
