@@ -48,6 +48,7 @@ inline FrameRequest render_frame_request(const RenderOptions& opt) {
     r.time = opt.time;
     r.animation = opt.animation;
     r.camera = opt.camera;
+    r.variant = opt.variant;
     r.fps = opt.fps;
     // A turntable (render.cpp: frames orbit unless --fps without --orbit).
     if (opt.frames > 1 && (opt.fps <= 0.0 || opt.orbit_given)) r.orbit_deg = opt.orbit_deg;

@@ -500,6 +500,14 @@ int list_model(const RenderOptions& opt) {
     std::printf("skins %zu\n", src ? src->skins.size() : std::size_t(0));
     for (std::size_t i = 0; src && i < src->skins.size(); ++i)
         std::printf("  skin %zu: %zu joints\n", i, src->skins[i].joints.size());
+    // KHR_materials_variants: a primitive remapped by a variant has a mapping for it.
+    std::printf("variants %zu\n", scene.variants.size());
+    for (std::size_t v = 0; v < scene.variants.size(); ++v) {
+        std::size_t remapped = 0;
+        for (const Mesh& m : scene.meshes) remapped += v < m.variant_materials.size() && m.variant_materials[v] >= 0;
+        std::printf("  variant %zu %s: remaps %zu of %zu primitives\n", v, name(scene.variants[v]).c_str(), remapped,
+                    scene.meshes.size());
+    }
     auto joined = [](const std::vector<std::string>& v) {
         std::string out;
         for (const std::string& s : v) out += (out.empty() ? "" : ", ") + printable(cut(s));

@@ -100,6 +100,7 @@ struct RenderOptions {
     std::string animation;
     double fps = 0.0;                  // 0: --frames is a turntable
     std::string camera;                // --camera: a camera of the file (name or index); empty: framed
+    std::string variant;               // --variant: a KHR_materials_variants variant (name or index); empty: none
     bool list = false;                 // --list: print the model's contents instead of rendering
     bool frame_range_given = false;
     int repeat = 1;

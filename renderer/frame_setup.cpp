@@ -9,6 +9,7 @@
 #include "scene/default_scene.h"
 #include "scene/load_environment.h"
 #include "scene/load_scene.h"
+#include "scene/tangents.h"
 #include "scene/messages.h"
 #include "renderer/memory_plan.h"
 
@@ -41,6 +42,19 @@ std::string not_found(const std::string& flag, const std::string& value, const s
     if (names.size() > 8) have += ", ...";
     return flag + " '" + cut(value) + "': " + scene + " has no " + what + " of that name or index (" +
            (names.empty() ? std::string("it has none") : "it has " + have) + ")";
+}
+
+// KHR_materials_variants: every primitive with a mapping for variant v
+// takes its material. Computed tangents follow the new material's normal map
+// when it reads another UV set (tangent_uvs), as the loader would have made them.
+void select_variant(Scene& scene, int v) {
+    for (Mesh& m : scene.meshes) {
+        if (std::size_t(v) >= m.variant_materials.size() || m.variant_materials[std::size_t(v)] < 0) continue;
+        const std::vector<glm::vec2>* before = &scene_detail::tangent_uvs(m, scene);
+        m.material = m.variant_materials[std::size_t(v)];
+        const std::vector<glm::vec2>& after = scene_detail::tangent_uvs(m, scene);
+        if (&after != before && !after.empty() && !m.normals.empty()) compute_tangents(m, after);
+    }
 }
 
 } // namespace
@@ -121,6 +135,11 @@ FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameSt
         for (const SceneCamera& c : out.scene.cameras) names.push_back(c.name);
         out.file_camera = find_named(names, req.camera);
         if (out.file_camera < 0) return {kFrameExitUsage, not_found("--camera", req.camera, scene_name, "camera", names)};
+    }
+    if (!req.variant.empty()) {
+        const int v = find_named(out.scene.variants, req.variant);
+        if (v < 0) return {kFrameExitUsage, not_found("--variant", req.variant, scene_name, "variant", out.scene.variants)};
+        select_variant(out.scene, v);  // before posing, whose tangents follow the material
     }
     out.time = req.time;
     if (out.scene.source && !out.scene.animation_names.empty()) pose_scene(out.scene, req.time, out.animation);

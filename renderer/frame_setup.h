@@ -73,6 +73,9 @@ struct FrameRequest {
     double time = 0.0;
     std::string animation;
     std::string camera;
+    // KHR_materials_variants: a variant's name or index (empty: the default
+    // materials); each primitive mapping it draws that variant's material.
+    std::string variant;
     double fps = 0.0;
     double orbit_deg = 0.0;                  // a turntable's sweep: the default framing holds over it
 

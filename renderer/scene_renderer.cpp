@@ -224,7 +224,7 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
             b.ext[i] = bind(r, m.extension_texture_srgb(&r));
             b.ext_uv[i] = set_of(r);
             if (!r.transform.present) continue;
-            b.ext_transformed = std::uint8_t(b.ext_transformed | (1u << i));
+            b.ext_transformed = std::uint16_t(b.ext_transformed | (1u << i));
             b.ext_xf[i] = UvTransform::of(r.transform);
         }
         bound_.push_back(b);

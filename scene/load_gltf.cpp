@@ -266,7 +266,10 @@ bool implemented_extension(const std::string& ext) {
         "KHR_materials_pbrSpecularGlossiness",  // converted to metal-rough at load
         "KHR_materials_sheen",
         "KHR_materials_specular",
+        "KHR_materials_transmission",
         "KHR_materials_unlit",
+        "KHR_materials_variants",
+        "KHR_materials_volume",
         "KHR_meshopt_compression",  // its version-0 streams: EXT_meshopt_compression's bitstream
         "KHR_mesh_quantization",
         "KHR_texture_transform",
@@ -446,6 +449,7 @@ public:
         image_map_.assign(model_.images.size(), kNotYet);
         for (std::size_t i = 0; i < model_.materials.size(); ++i)
             scene_.materials.push_back(convert_material(model_.materials[i], i));
+        read_variants();
         traverse_scene();
         GltfGraphContext graph{shown_, elements_, zero_filled_, [this](const std::string& w) { warn(w); }};
         read_gltf_graph(model_, scene_, graph);  // skins, morph targets, animations, cameras
@@ -1438,6 +1442,10 @@ private:
                 clearcoat_extension(value, m, what, index);
             } else if (name == "KHR_materials_sheen") {
                 sheen_extension(value, m, what, index);
+            } else if (name == "KHR_materials_transmission") {
+                transmission_extension(value, m, what, index);
+            } else if (name == "KHR_materials_volume") {
+                volume_extension(value, m, what, index);
             } else if (name != "KHR_materials_pbrSpecularGlossiness") {
                 warn(what + ": extension " + cut(name) + " ignored");
             }
@@ -1578,6 +1586,59 @@ private:
         m.sheen_roughness_texture = material_extension_texture(v, "sheenRoughnessTexture", what, index);
         // A black sheen colour disables the layer (the extension): the bytes of the file without it.
         m.has_sheen = m.sheen_color_factor != glm::vec3(0.0f);
+    }
+
+    // ---- KHR_materials_transmission and KHR_materials_volume
+
+    void transmission_extension(const tinygltf::Value& v, Material& m, const std::string& what_material,
+                                std::size_t index) {
+        const std::string what = what_material + " KHR_materials_transmission";
+        if (!v.IsObject()) {
+            warn(what + ": not an object, ignored");
+            return;
+        }
+        m.transmission_factor = extension_number(v, "transmissionFactor", 0.0f, 0.0f, 1.0f, what);
+        m.transmission_texture = material_extension_texture(v, "transmissionTexture", what, index);
+        // transmissionFactor 0 transmits nothing: the material keeps the
+        // bytes it has without the extension.
+        m.has_transmission = m.transmission_factor > 0.0f;
+    }
+
+    void volume_extension(const tinygltf::Value& v, Material& m, const std::string& what_material, std::size_t index) {
+        const std::string what = what_material + " KHR_materials_volume";
+        if (!v.IsObject()) {
+            warn(what + ": not an object, ignored");
+            return;
+        }
+        m.has_volume = true;
+        m.thickness_factor = extension_number(v, "thicknessFactor", 0.0f, 0.0f, 3.0e38f, what);
+        m.thickness_texture = material_extension_texture(v, "thicknessTexture", what, index);
+        // attenuationDistance: > 0, absent = infinite (stored as 0: no attenuation).
+        const tinygltf::Value& d = v.Get("attenuationDistance");
+        if (d.Type() != tinygltf::NULL_TYPE) {
+            const double x = d.IsNumber() ? d.GetNumberAsDouble() : std::nan("");
+            if (!(x > 0.0) || !std::isfinite(x) || x > 3.0e38)
+                warn(what + ": bad attenuationDistance (not a positive finite number), infinite used");
+            else
+                m.attenuation_distance = float(x);
+        }
+        const tinygltf::Value& c = v.Get("attenuationColor");
+        if (c.Type() != tinygltf::NULL_TYPE) {
+            bool ok = c.IsArray() && c.ArrayLen() == 3;
+            for (int i = 0; ok && i < 3; ++i) ok = c.Get(i).IsNumber() && std::isfinite(c.Get(i).GetNumberAsDouble());
+            if (!ok) {
+                warn(what + ": bad attenuationColor (not three finite numbers), [1, 1, 1] used");
+            } else {
+                bool outside = false;
+                for (int i = 0; i < 3; ++i) {
+                    const double x = c.Get(i).GetNumberAsDouble();
+                    outside = outside || x < 0.0 || x > 1.0;
+                    m.attenuation_color[i] = float(std::clamp(x, 0.0, 1.0));
+                }
+                if (outside) warn(what + ": attenuationColor outside [0, 1], clamped");
+            }
+        }
+        // A volume without transmission has no effect (the extension): it is kept, unused.
     }
 
     // ---- KHR_materials_pbrSpecularGlossiness, converted to metal-rough
@@ -1852,6 +1913,7 @@ private:
             }
             Mesh mesh;
             mesh.name = !gmesh.name.empty() ? gmesh.name : node.name;
+            mesh.variant_materials = variant_mappings(prim, what);  // before: its materials may read TEXCOORD_1
             if (!read_primitive(prim, what, world, mesh)) continue;
             if (prim.material >= 0 && std::size_t(prim.material) >= model_.materials.size()) {
                 warn(what + ": material " + std::to_string(prim.material) + " out of range, default used");
@@ -1896,9 +1958,11 @@ private:
         if (normal >= 0) nrm = read_accessor<float>(normal, TINYGLTF_TYPE_VEC3, what + " NORMAL");
         if (texcoord >= 0) uv = read_accessor<float>(texcoord, TINYGLTF_TYPE_VEC2, what + " TEXCOORD_0");
         // TEXCOORD_1 only for a material that samples it: other files read what they always did.
-        if (texcoord1 >= 0 && reads_uv1(prim.material))
+        bool wants_uv1 = reads_uv1(prim.material);
+        for (int vm : mesh.variant_materials) wants_uv1 = wants_uv1 || reads_uv1(vm);
+        if (texcoord1 >= 0 && wants_uv1)
             uv1 = read_accessor<float>(texcoord1, TINYGLTF_TYPE_VEC2, what + " TEXCOORD_1");
-        else if (reads_uv1(prim.material))
+        else if (wants_uv1)
             warn(what + ": its material reads TEXCOORD_1, which it lacks (sampled at 0, 0)");
         if (tangent >= 0) tan = read_accessor<float>(tangent, TINYGLTF_TYPE_VEC4, what + " TANGENT");
         int color_components = 0;
@@ -1982,6 +2046,104 @@ private:
         }
         mesh.indices = std::move(indices);
         return true;
+    }
+
+    // ---- KHR_materials_variants
+
+    // A JSON number that is a whole number in [0, limit): it; else -1.
+    static long whole_index(const tinygltf::Value& v, std::size_t limit) {
+        if (!v.IsNumber()) return -1;
+        const double d = v.GetNumberAsDouble();
+        if (!(d >= 0.0) || d != std::floor(d) || d >= double(limit)) return -1;
+        return long(d);
+    }
+
+    // The root's variants: names, in order. A malformed entry keeps its
+    // index (the mappings count by it) with the name "variant N".
+    void read_variants() {
+        const auto ext = model_.extensions.find("KHR_materials_variants");
+        if (ext == model_.extensions.end()) return;
+        const std::string what = "KHR_materials_variants";
+        const tinygltf::Value& root = ext->second;
+        const tinygltf::Value& list = root.IsObject() ? root.Get("variants") : root;
+        if (!root.IsObject() || !list.IsArray()) {
+            warn(what + ": no 'variants' array, no variants");
+            return;
+        }
+        // The index a mapping names is an int: a longer list is not a real file.
+        constexpr std::size_t kMaxVariants = 1u << 16;
+        if (list.ArrayLen() > kMaxVariants) {
+            warn(what + ": " + std::to_string(list.ArrayLen()) + " variants, more than " +
+                 std::to_string(kMaxVariants) + ", no variants");
+            return;
+        }
+        std::set<std::string> seen;
+        for (std::size_t i = 0; i < list.ArrayLen(); ++i) {
+            const tinygltf::Value& v = list.Get(int(i));
+            const tinygltf::Value& name = v.IsObject() ? v.Get("name") : v;
+            std::string n = "variant " + std::to_string(i);
+            if (!v.IsObject() || !name.IsString())
+                warn(what + ": variant " + std::to_string(i) + " has no name string, called '" + n + "'");
+            else
+                n = name.Get<std::string>();
+            if (!seen.insert(n).second)
+                warn(what + ": variant " + std::to_string(i) + " repeats the name '" + cut(n) +
+                     "' (that name selects the first; the index selects this one)");
+            scene_.variants.push_back(n);
+        }
+    }
+
+    // The primitive's mappings as one material per variant (-1: none).
+    // Problems are one warning each (once per primitive, however many nodes
+    // instance it), and never drop more than the entry at fault.
+    std::vector<int> variant_mappings(const tinygltf::Primitive& prim, const std::string& what_primitive) {
+        const auto ext = prim.extensions.find("KHR_materials_variants");
+        if (ext == prim.extensions.end()) return {};
+        const std::string what = what_primitive + " KHR_materials_variants";
+        const tinygltf::Value& v = ext->second;
+        const tinygltf::Value& mappings = v.IsObject() ? v.Get("mappings") : v;
+        if (!v.IsObject() || !mappings.IsArray()) {
+            warn_once(what + ": no 'mappings' array, ignored");
+            return {};
+        }
+        if (scene_.variants.empty()) {
+            warn_once(what + ": the file defines no variants, mappings ignored");
+            return {};
+        }
+        std::vector<int> out(scene_.variants.size(), -1);
+        for (std::size_t k = 0; k < mappings.ArrayLen(); ++k) {
+            const tinygltf::Value& m = mappings.Get(int(k));
+            const std::string at = what + " mapping " + std::to_string(k);
+            if (!m.IsObject()) {
+                warn_once(at + ": not an object, ignored");
+                continue;
+            }
+            const long material = whole_index(m.Get("material"), model_.materials.size());
+            if (material < 0) {
+                warn_once(at + ": material is not an index of the file's " + std::to_string(model_.materials.size()) +
+                          " materials, ignored");
+                continue;
+            }
+            const tinygltf::Value& variants = m.Get("variants");
+            if (!variants.IsArray() || variants.ArrayLen() == 0) {
+                warn_once(at + ": 'variants' is not a non-empty array, ignored");
+                continue;
+            }
+            for (std::size_t j = 0; j < variants.ArrayLen(); ++j) {
+                const long vi = whole_index(variants.Get(int(j)), scene_.variants.size());
+                if (vi < 0) {
+                    warn_once(at + ": variant entry " + std::to_string(j) + " is not an index of the " +
+                              std::to_string(scene_.variants.size()) + " variants, ignored");
+                } else if (out[std::size_t(vi)] >= 0) {
+                    // The extension: a variant appears in at most one mapping of a primitive.
+                    warn_once(at + ": variant " + std::to_string(vi) + " is mapped already, material " +
+                              std::to_string(out[std::size_t(vi)]) + " kept");
+                } else {
+                    out[std::size_t(vi)] = int(material);
+                }
+            }
+        }
+        return out;
     }
 
     // True when material `index` (a glTF index, converted already) has a texture on TEXCOORD_1.

@@ -130,17 +130,32 @@ struct Material {
     TextureRef sheen_color_texture;            // sRGB, RGB
     TextureRef sheen_roughness_texture;        // A
 
+    // KHR_materials_transmission: the share of the dielectric's diffuse that
+    // is transmitted instead (docs/shading.md, "Transmission"). Off (or
+    // factor 0): no transmission at all. KHR_materials_volume gives the
+    // transmitting surface a thickness (0: thin-walled) and Beer-Lambert
+    // attenuation; it does nothing without transmission.
+    bool has_transmission = false;
+    float transmission_factor = 0.0f;          // [0, 1]
+    TextureRef transmission_texture;           // R
+    bool has_volume = false;
+    float thickness_factor = 0.0f;             // >= 0, world units
+    TextureRef thickness_texture;              // G
+    float attenuation_distance = 0.0f;         // > 0; 0: infinite (no attenuation)
+    glm::vec3 attenuation_color{1.0f};         // [0, 1]
+
     // The extension textures above, for code that walks every map (in
     // BoundMaterial::ExtMap's order).
     std::vector<const TextureRef*> extension_textures() const {
         return {&specular_texture, &specular_color_texture, &clearcoat_texture, &clearcoat_roughness_texture,
-                &clearcoat_normal_texture, &sheen_color_texture, &sheen_roughness_texture};
+                &clearcoat_normal_texture, &sheen_color_texture, &sheen_roughness_texture, &transmission_texture,
+                &thickness_texture};
     }
     // Which of them hold sRGB colour (the others are linear data).
     bool extension_texture_srgb(const TextureRef* r) const {
         return r == &specular_color_texture || r == &sheen_color_texture;
     }
-    bool layered() const { return has_specular || has_clearcoat || has_sheen; }
+    bool layered() const { return has_specular || has_clearcoat || has_sheen || has_transmission; }
 };
 
 struct Mesh {
@@ -165,6 +180,10 @@ struct Mesh {
     // The primitive's vertex of each vertex here, once the loader has dropped
     // unused ones; filled only when the scene has a SceneSource.
     std::vector<std::uint32_t> source_vertex;
+    // KHR_materials_variants: the material of each of Scene::variants on
+    // this primitive, -1 where its mappings name none (the default, `material`,
+    // is drawn); empty when the primitive has no mappings.
+    std::vector<int> variant_materials;
 };
 
 struct Light {
@@ -218,6 +237,10 @@ struct Scene {
     std::vector<SceneCamera> cameras;          // the file's, in node order
     std::vector<std::string> animation_names;  // one per animation ("animation N" when unnamed)
     std::vector<std::string> extensions_used, extensions_required;  // glTF's lists, for render --list
+    // KHR_materials_variants: the variants' names, in the file's order (an
+    // unnamed or malformed entry keeps its place as "variant N"); `render
+    // --variant` picks one, Mesh::variant_materials maps it.
+    std::vector<std::string> variants;
     // Counts the poses applied, so that what is drawn from the meshes
     // (shadow maps) is redrawn when they change.
     std::uint64_t pose_serial = 0;

@@ -325,7 +325,59 @@ struct BrdfInputs {
     glm::vec3 sheen_color{0.0f};
     float sheen_roughness = 0.0f;
     bool has_sheen() const { return sheen_color.x > 0.0f || sheen_color.y > 0.0f || sheen_color.z > 0.0f; }
+    // KHR_materials_transmission: the share of the dielectric's diffuse
+    // transmitted instead (0: none, the base's arithmetic unchanged), the
+    // transmission lobe's perceptual roughness (transmission_roughness())
+    // and KHR_materials_volume's transmittance (volume_transmittance()).
+    float transmission = 0.0f;
+    float transmission_roughness = 0.0f;
+    glm::vec3 transmittance{1.0f};
+    float thickness = 0.0f;  // KHR_materials_volume's (0: thin-walled), for transmission_direction()
+    // --energy conserve: the transmission lobe times transmission_comp =
+    // (1 - E_spec) / ((1 - F0) A + (1 - F90) B), so that it carries all the
+    // reflection leaves, as the diffuse's kd does (apply_energy_terms()).
+    glm::vec3 transmission_comp{1.0f};
 };
+
+// Where the environment is seen through a transmitting surface (what the
+// Sample Viewer reads from the frame behind it, without a screen-space pass):
+// straight on, -v, through a thin wall; through a volume, Filament's "solid
+// sphere": refracted in (1 / ior), then out through a back face whose normal
+// is (n.r) r - n / 2 normalised, refracted by ior (r itself where that
+// reflects totally). n and v unit.
+inline glm::vec3 transmission_direction(const glm::vec3& n, const glm::vec3& v, float ior, float thickness) {
+    if (!(thickness > 0.0f) || !(ior > 0.0f)) return -v;
+    const glm::vec3 r = glm::refract(-v, n, 1.0f / ior);
+    const float rl2 = glm::dot(r, r);
+    if (!(rl2 > 1e-12f)) return -v;
+    const glm::vec3 m = r * glm::dot(n, r) - n * 0.5f;
+    const float ml2 = glm::dot(m, m);
+    if (!(ml2 > 1e-12f)) return r / std::sqrt(rl2);
+    const glm::vec3 out = glm::refract(r, m / std::sqrt(ml2), ior);
+    const float ol2 = glm::dot(out, out);
+    return ol2 > 1e-12f ? out / std::sqrt(ol2) : r / std::sqrt(rl2);
+}
+
+// The transmission lobe's perceptual roughness: the Khronos Sample Viewer's
+// applyIorToRoughness, r clamp(2 ior - 2, 0, 1) (an ior of 1 does not blur
+// what is seen through the surface).
+inline float transmission_roughness(float r, float ior) {
+    return r * glm::clamp(ior * 2.0f - 2.0f, 0.0f, 1.0f);
+}
+
+// KHR_materials_volume's Beer-Lambert attenuation over a path of length
+// `thickness`: per channel exp(-sigma d) with sigma = -ln(colour) / distance,
+// i.e. colour^(d / distance); 1 for a thin wall (thickness 0) or an infinite
+// distance (0). In double with the sheen's own exp and log (no libm variant
+// changes a pixel), rounded once.
+inline glm::vec3 volume_transmittance(float thickness, float distance, const glm::vec3& color) {
+    if (!(thickness > 0.0f) || !(distance > 0.0f)) return glm::vec3(1.0f);
+    glm::vec3 t;
+    for (int c = 0; c < 3; ++c)
+        t[c] = color[c] > 0.0f ? float(brdf_detail::det_pow(double(color[c]), double(thickness) / double(distance)))
+                               : 0.0f;
+    return t;
+}
 
 // The clear coat's F0: a dielectric of ior 1.5, as KHR_materials_clearcoat fixes it.
 constexpr float kClearcoatF0 = 0.04f;
@@ -370,7 +422,30 @@ struct BrdfTerms {
     bool sheen = false;
     float sheen_D = 0.0f, sheen_V = 0.0f, sheen_scaling = 1.0f;
     glm::vec3 sheen_f{0.0f};
+    // KHR_materials_transmission (transmission true): the diffuse above is
+    // already times 1 - transmission. A light behind the surface (n.l < 0)
+    // reaches the eye through the lobe the Sample Viewer uses: l mirrored
+    // through the surface's plane to l', h_t = (l' + v) normalised, and
+    // tr_f = transmission (1 - metallic) (1 - F(v.h_t)) albedo D G (or V) x
+    // transmittance at the transmission roughness, which the caller
+    // multiplies by radiance * n.l' (brdf_light()).
+    bool transmission = false;
+    float tr_NoL = 0.0f, tr_NoH = 0.0f, tr_VoH = 0.0f, tr_D = 0.0f, tr_G = 0.0f;
+    glm::vec3 tr_F{0.0f}, tr_f{0.0f};
 };
+
+// The inputs' Fresnel at v.h: evaluate_brdf()'s F, for the transmission lobe.
+inline glm::vec3 brdf_fresnel(const BrdfInputs& in, float VoH) {
+    if (in.conductor != Conductor::None) {
+        ConductorIOR ior = conductor_ior(in.conductor);
+        return F_ConductorSchlick(ior.eta, ior.k, VoH);
+    }
+    if (in.specular_ext) {
+        const glm::vec3 F0 = brdf_f0(in);
+        return F0 + (glm::vec3(brdf_f90(in)) - F0) * brdf_detail::pow5(1.0f - VoH);
+    }
+    return F_Schlick(glm::mix(glm::vec3(f0_from_ior(in.ior)), in.albedo, in.metallic), VoH);
+}
 
 inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
     BrdfTerms t;
@@ -419,6 +494,36 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
     // Evaluate the diffuse lobe: what the specular reflection leaves, if not a metal.
     t.kd = in.energy ? in.energy_kd : (glm::vec3(1.0f) - t.F) * (1.0f - metallic);
     t.diffuse = t.kd * in.albedo * Fd_Lambert();
+    if (in.transmission > 0.0f) {
+        // KHR_materials_transmission: the transmitted share leaves the diffuse.
+        t.transmission = true;
+        t.diffuse = t.diffuse * (1.0f - in.transmission);
+        const float NoL = glm::dot(in.n, in.l);
+        if (NoL < 0.0f) {
+            const glm::vec3 lm = in.l - in.n * (2.0f * NoL);
+            const glm::vec3 hs = lm + in.v;
+            const float hl2 = glm::dot(hs, hs);
+            const glm::vec3 ht = hl2 > 0.0f ? hs / std::sqrt(hl2) : in.n;
+            t.tr_NoL = glm::clamp(glm::dot(in.n, lm), 0.0f, 1.0f);
+            t.tr_NoH = glm::clamp(glm::dot(in.n, ht), 0.0f, 1.0f);
+            t.tr_VoH = glm::clamp(glm::dot(in.v, ht), 0.0f, 1.0f);
+            const float rt = glm::clamp(in.transmission_roughness, kMinPerceptualRoughness, 1.0f);
+            const float at = rt * rt;
+            t.tr_F = brdf_fresnel(in, t.tr_VoH);
+            t.tr_D = D_GGX(t.tr_NoH, at);
+            float lobe;
+            if (model == BrdfModel::Gltf) {
+                t.tr_G = V_SmithGGXCorrelated(t.NoV, t.tr_NoL, at);
+                lobe = t.tr_D * t.tr_G;
+            } else {
+                t.tr_G = G_Smith(t.NoV, t.tr_NoL, in.ibl_geometry ? k_ibl(rt) : k_direct(rt));
+                lobe = t.tr_D * t.tr_G / (4.0f * std::max(t.NoV, kBrdfMinCos) * std::max(t.tr_NoL, kBrdfMinCos));
+            }
+            t.tr_f = (glm::vec3(1.0f) - t.tr_F) * in.albedo * in.transmittance *
+                     (in.transmission * (1.0f - metallic) * lobe);
+            if (in.energy) t.tr_f = t.tr_f * in.transmission_comp;
+        }
+    }
     t.f = t.diffuse + t.specular;
     if (in.has_sheen()) {
         // KHR_materials_sheen: the Charlie lobe over the base, which keeps
@@ -433,6 +538,7 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
         t.diffuse = t.diffuse * t.sheen_scaling;
         t.specular = t.specular * t.sheen_scaling;
         t.sheen_f = in.sheen_color * (t.sheen_D * t.sheen_V);
+        t.tr_f = t.tr_f * t.sheen_scaling;
         t.f = t.diffuse + t.specular + t.sheen_f;
     }
     if (in.clearcoat > 0.0f) {
@@ -460,6 +566,7 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
         t.coat_specular = in.clearcoat * t.coat_F * lobe;
         t.diffuse = t.diffuse * t.coat_attenuation;
         t.specular = t.specular * t.coat_attenuation;
+        t.tr_f = t.tr_f * t.coat_attenuation;
         t.f = t.diffuse + t.specular;
         if (t.sheen) {  // the sheen lies under the coat too
             t.sheen_f = t.sheen_f * t.coat_attenuation;
@@ -474,6 +581,7 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
 inline glm::vec3 brdf_light(const BrdfTerms& t, const glm::vec3& radiance) {
     glm::vec3 c = t.f * radiance * t.NoL;
     if (t.coat) c += glm::vec3(t.coat_specular) * radiance * t.coat_NoL;
+    if (t.transmission) c += t.tr_f * radiance * t.tr_NoL;
     return c;
 }
 

@@ -76,11 +76,12 @@ struct BoundMaterial {
     // layered material does not take the lanes (PbrProgram::lit_lanes()).
     enum ExtMap {
         kSpecular, kSpecularColor, kClearcoat, kClearcoatRoughness, kClearcoatNormal, kSheenColor, kSheenRoughness,
-        kExtMaps
+        kTransmission, kThickness, kExtMaps
     };
     const Texture* ext[kExtMaps] = {};
     std::uint8_t ext_uv[kExtMaps] = {};
-    std::uint8_t ext_transformed = 0;
+    std::uint16_t ext_transformed = 0;  // bit i: ext map i
+    static_assert(kExtMaps <= 16, "ext_transformed holds a bit per extension map");
     UvTransform ext_xf[kExtMaps] = {};
     const UvTransform* ext_transform_of(int map) const {
         return (ext_transformed >> map) & 1u ? &ext_xf[map] : nullptr;
@@ -140,6 +141,13 @@ struct MaterialSample {
     // KHR_materials_sheen: colour (0: none) and perceptual roughness.
     glm::vec3 sheen_color{0.0f};
     float sheen_roughness = 0.0f;
+    // KHR_materials_transmission: factor x texture R (0: none);
+    // KHR_materials_volume: thickness factor x texture G (0: thin-walled),
+    // attenuation distance (0: infinite) and colour.
+    float transmission = 0.0f;
+    float thickness = 0.0f;
+    float attenuation_distance = 0.0f;
+    glm::vec3 attenuation_color{1.0f};
 };
 
 struct ShadingLight {
@@ -408,6 +416,18 @@ inline void sample_layers(const BoundMaterial& bm, const SurfacePoint& sp, const
         s.sheen_color = glm::clamp(s.sheen_color, glm::vec3(0.0f), glm::vec3(1.0f));
         s.sheen_roughness = glm::clamp(s.sheen_roughness, 0.0f, 1.0f);
     }
+    if (m.has_transmission) {
+        s.transmission = m.transmission_factor;
+        if (bm.ext[B::kTransmission]) s.transmission *= surface_detail::fetch_ext(bm, B::kTransmission, sp, lods).r;
+        s.transmission = glm::clamp(s.transmission, 0.0f, 1.0f);
+        if (m.has_volume) {
+            s.thickness = m.thickness_factor;
+            if (bm.ext[B::kThickness]) s.thickness *= surface_detail::fetch_ext(bm, B::kThickness, sp, lods).g;
+            s.thickness = std::max(s.thickness, 0.0f);
+            s.attenuation_distance = m.attenuation_distance;
+            s.attenuation_color = m.attenuation_color;
+        }
+    }
 }
 
 inline MaterialSample sample_material(const BoundMaterial& bm, const SurfacePoint& sp, const MaterialLods& lods) {
@@ -490,6 +510,10 @@ inline void apply_energy_terms(BrdfInputs& in, const DfgTable& table) {
         const float E = (F0[c] * ab.x + (in.specular_ext ? F90 * ab.y : ab.y)) * comp;
         in.energy_comp[c] = comp;
         in.energy_kd[c] = (1.0f - E) * (1.0f - metal);
+        if (in.transmission > 0.0f) {
+            const float lobe = (1.0f - F0[c]) * ab.x + (1.0f - (in.specular_ext ? F90 : 1.0f)) * ab.y;
+            in.transmission_comp[c] = lobe > 1e-6f ? (1.0f - E) / lobe : 1.0f;
+        }
     }
 }
 
@@ -518,8 +542,15 @@ inline BrdfInputs plain_brdf_inputs(const MaterialSample& ms, const SurfacePoint
     }
     in.sheen_color = ms.sheen_color;
     in.sheen_roughness = ms.sheen_roughness;
+    if (ms.transmission > 0.0f) {
+        in.transmission = ms.transmission;
+        in.transmission_roughness = transmission_roughness(ms.roughness, ms.ior);
+        in.transmittance = volume_transmittance(ms.thickness, ms.attenuation_distance, ms.attenuation_color);
+        in.thickness = ms.thickness;
+    }
     return in;
 }
+
 
 // The emission under a clear coat: times 1 - clearcoat F_coat(n_c.v), the
 // coat's Fresnel at the view, as KHR_materials_clearcoat darkens it.
@@ -571,14 +602,27 @@ struct IblTerms {
     bool sheen = false;
     float sheen_E = 0.0f, sheen_scaling = 1.0f;
     glm::vec3 sheen_irradiance{0.0f}, sheen_specular{0.0f};
+    // KHR_materials_transmission (transmission): transmission (1 - metallic)
+    // tr_albedo albedo prefiltered(tr_dir, tr_level) transmittance occlusion,
+    // tr_albedo = (1 - F0) A + (1 - F90) B (with --energy conserve
+    // 1 - specular albedo), the environment behind seen through the
+    // surface (transmission_direction()) at the level of the transmission
+    // roughness; diffuse above is times 1 - transmission (and the sheen's
+    // and coat's factors apply to it as to the diffuse).
+    bool transmission = false;
+    glm::vec3 tr_dir{0.0f}, tr_prefiltered{0.0f}, tr_transmittance{1.0f}, tr_albedo{0.0f}, tr_specular{0.0f};
+    float tr_level = 0.0f;
 };
 
 // What the environment adds to Lo: diffuse + specular (+ the coat's lobe).
 inline glm::vec3 ibl_sum(const IblTerms& t) {
-    if (t.sheen && t.coat) return t.diffuse + t.specular + t.sheen_specular + t.coat_specular;
-    if (t.sheen) return t.diffuse + t.specular + t.sheen_specular;
-    if (t.coat) return t.diffuse + t.specular + t.coat_specular;
-    return t.diffuse + t.specular;
+    glm::vec3 s;
+    if (t.sheen && t.coat) s = t.diffuse + t.specular + t.sheen_specular + t.coat_specular;
+    else if (t.sheen) s = t.diffuse + t.specular + t.sheen_specular;
+    else if (t.coat) s = t.diffuse + t.specular + t.coat_specular;
+    else s = t.diffuse + t.specular;
+    if (t.transmission) s += t.tr_specular;
+    return s;
 }
 
 // ctx.env and ctx.dfg_ibl must be set. The lane code (light_block.h) performs
@@ -651,6 +695,32 @@ inline IblTerms ibl_terms(const MaterialSample& ms, const SurfacePoint& sp, cons
     t.occlusion = ms.occlusion;
     t.diffuse = t.kd * ms.albedo * t.irradiance * ms.occlusion;
     t.specular = t.specular_albedo * t.prefiltered * ms.occlusion;
+    if (ms.transmission > 0.0f) {
+        // KHR_materials_transmission: the albedo of the transmission lobe
+        // evaluate_brdf() gives lights, (1 - F) D G mirrored, is (1 - F0) A +
+        // (1 - F90) B, which at roughness 0 is the Sample Viewer's
+        // 1 - (F0 A + F90 B) (and is that with --energy conserve); times the
+        // albedo and what is behind, here the environment.
+        t.transmission = true;
+        const glm::vec3 F0t = brdf_f0(in);
+        const float F90t = brdf_f90(in);
+        // With --energy conserve: all the reflection leaves, 1 - E_spec.
+        for (int c = 0; c < 3; ++c)
+            t.tr_albedo[c] = ctx.energy ? 1.0f - t.specular_albedo[c] : (1.0f - F0t[c]) * dfg.x + (1.0f - F90t) * dfg.y;
+        const float rt = glm::clamp(transmission_roughness(ms.roughness, ms.ior), kMinPerceptualRoughness, 1.0f);
+        // The lobe's dominant direction bent towards -n as it roughens: the
+        // reflection's mix(R, n, alpha^2) above, mirrored through the plane
+        // (R mirrored is -v), then turned as -v is to the volume's exit.
+        const float ft = (rt * rt) * (rt * rt);
+        t.tr_dir = transmission_direction(n, v, ms.ior, ms.thickness) * (1.0f - ft) - n * ft;
+        t.tr_level = Environment::roughness_lod(rt);
+        t.tr_prefiltered = env.prefiltered(t.tr_dir, t.tr_level);
+        t.tr_level = glm::clamp(t.tr_level, 0.0f, float(Environment::kSpecularLevels - 1));
+        t.tr_transmittance = volume_transmittance(ms.thickness, ms.attenuation_distance, ms.attenuation_color);
+        t.diffuse = t.diffuse * (1.0f - ms.transmission);
+        t.tr_specular = t.tr_albedo * ms.albedo * t.tr_prefiltered * t.tr_transmittance *
+                        (ms.transmission * (1.0f - metal) * ms.occlusion);
+    }
     if (ms.sheen_color.x > 0.0f || ms.sheen_color.y > 0.0f || ms.sheen_color.z > 0.0f) {
         // The sheen's split sum: its albedo E(n.v) times the irradiance
         // E(n)/pi: the Charlie lobe is broad and grazing, and against the
@@ -664,6 +734,7 @@ inline IblTerms ibl_terms(const MaterialSample& ms, const SurfacePoint& sp, cons
         t.sheen_irradiance = env.irradiance(n);
         t.diffuse = t.diffuse * t.sheen_scaling;
         t.specular = t.specular * t.sheen_scaling;
+        t.tr_specular = t.tr_specular * t.sheen_scaling;
         t.sheen_specular = ms.sheen_color * t.sheen_E * t.sheen_irradiance * ms.occlusion;
     }
     if (ms.clearcoat > 0.0f) {
@@ -689,6 +760,7 @@ inline IblTerms ibl_terms(const MaterialSample& ms, const SurfacePoint& sp, cons
         t.diffuse = t.diffuse * t.coat_attenuation;
         t.specular = t.specular * t.coat_attenuation;
         t.sheen_specular = t.sheen_specular * t.coat_attenuation;
+        t.tr_specular = t.tr_specular * t.coat_attenuation;
         t.coat_specular = t.coat_prefiltered * (ms.clearcoat * t.coat_F * (cd.x + cd.y)) * ms.occlusion;
     }
     return t;

@@ -784,7 +784,8 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
     {
         static const char* const kExtNames[BoundMaterial::kExtMaps] = {
             "specularTexture", "specularColorTexture", "clearcoatTexture", "clearcoatRoughnessTexture",
-            "clearcoatNormalTexture", "sheenColorTexture", "sheenRoughnessTexture"};
+            "clearcoatNormalTexture", "sheenColorTexture", "sheenRoughnessTexture", "transmissionTexture",
+            "thicknessTexture"};
         for (int i = 0; i < BoundMaterial::kExtMaps; ++i) {
             if (!bm.ext[i]) continue;
             glm::vec2 uv = sp.uv_of(bm.ext_uv[i]);
@@ -829,6 +830,19 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
           << " (clamped " << num(rs) << ", alpha " << num(rs * rs) << "), Charlie D and V, albedo E(n.v) "
           << num(sheen_albedo(glm::clamp(glm::dot(sh.inputs.n, sh.inputs.v), 0.0f, 1.0f), rs)) << "\n";
     }
+    if (sh.inputs.transmission > 0.0f) {
+        const float rt = glm::clamp(sh.inputs.transmission_roughness, kMinPerceptualRoughness, 1.0f);
+        o << "  KHR_materials_transmission: transmission " << num(ms.transmission)
+          << " (the diffuse times 1 - transmission), roughness r clamp(2 ior - 2, 0, 1) "
+          << num(sh.inputs.transmission_roughness) << " (clamped " << num(rt) << ")";
+        if (ms.thickness > 0.0f)
+            o << "; KHR_materials_volume: thickness " << num(ms.thickness) << ", attenuation colour "
+              << vec(ms.attenuation_color) << " at distance "
+              << (ms.attenuation_distance > 0.0f ? num(ms.attenuation_distance) : std::string("infinite"));
+        else
+            o << ", thin-walled";
+        o << " -> transmittance colour^(thickness / distance) " << vec(sh.inputs.transmittance) << "\n";
+    }
     o << "  v " << vec(sh.inputs.v) << " (towards the eye " << vec(s.settings.camera.eye) << " from P " << vec(sp.P)
       << ")\n";
     for (std::size_t i = 0; i < sh.lights.size(); ++i) {
@@ -857,15 +871,24 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
         o << "    diffuse " << vec(t.diffuse) << "  specular " << vec(t.specular)
           << (t.coat ? "  (both times the coat's 1 - clearcoat F_coat = " + num(t.coat_attenuation) + ")" : std::string())
           << "\n";
+        if (t.transmission)
+            o << "    transmission: " << (t.tr_NoL > 0.0f ? std::string("the light is behind: l mirrored through the "
+                                                                    "surface, n.l' ")
+                                                      : std::string("the light is in front: n.l' "))
+              << num(t.tr_NoL) << "  n.h_t " << num(t.tr_NoH) << "  v.h_t " << num(t.tr_VoH) << "  D " << num(t.tr_D)
+              << "  " << (s.settings.model == BrdfModel::Gltf ? "V " : "G ") << num(t.tr_G) << "  F " << vec(t.tr_F)
+              << " -> transmission (1 - metallic) (1 - F) albedo D " << (s.settings.model == BrdfModel::Gltf ? "V" : "G / (4 n.v n.l')")
+              << " transmittance " << vec(t.tr_f) << ", times radiance * n.l'\n";
         if (t.coat) {
             o << "    clear coat: n_c.l " << num(t.coat_NoL) << "  n_c.v " << num(t.coat_NoV) << "  n_c.h "
               << num(t.coat_NoH) << "  D " << num(t.coat_D) << "  " << (s.settings.model == BrdfModel::Gltf ? "V " : "G ")
               << num(t.coat_G) << "  F_coat(n_c.v) " << num(t.coat_F) << " -> coat lobe clearcoat F_coat D "
               << (s.settings.model == BrdfModel::Gltf ? "V " : "G / (4 n_c.v n_c.l) ") << num(t.coat_specular) << "\n";
-            o << "    contribution (diffuse + specular) * radiance * n.l + coat * radiance * n_c.l = "
-              << vec(L.contribution) << "\n";
+            o << "    contribution (diffuse + specular) * radiance * n.l + coat * radiance * n_c.l"
+              << (t.transmission ? " + transmission * radiance * n.l'" : "") << " = " << vec(L.contribution) << "\n";
         } else {
-            o << "    contribution (diffuse + specular) * radiance * n.l = " << vec(L.contribution) << "\n";
+            o << "    contribution (diffuse + specular) * radiance * n.l"
+              << (t.transmission ? " + transmission * radiance * n.l'" : "") << " = " << vec(L.contribution) << "\n";
         }
     }
     o << "  emissive " << vec(ms.emissive);
@@ -880,6 +903,12 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
           << ", dfg scale " << num(t.dfg_scale) << " bias " << num(t.dfg_bias) << " (n.v " << num(t.NoV)
           << ") -> specular " << vec(t.specular) << "\n";
         if (ms.has_specular) o << "    KHR_materials_specular: specular albedo F0 A + F90 B with F90 " << num(t.F90) << "\n";
+        if (t.transmission)
+            o << "    transmission: prefiltered " << vec(t.tr_prefiltered) << " along " << vec(t.tr_dir)
+              << (ms.thickness > 0.0f ? " (refracted through the volume)" : " (straight through, -v)") << " at level "
+              << num(t.tr_level) << ", transmittance " << vec(t.tr_transmittance) << (s.settings.energy ? ", lobe albedo 1 - specular albedo " : ", lobe albedo (1 - F0) A + (1 - F90) B ")
+              << vec(t.tr_albedo) << " -> transmission (1 - metallic) lobe albedo x albedo prefiltered transmittance occlusion "
+              << vec(t.tr_specular) << "; diffuse above times 1 - transmission\n";
         if (t.sheen)
             o << "    sheen: irradiance E(n)/pi " << vec(t.sheen_irradiance) << ", E(n.v) " << num(t.sheen_E)
               << " -> colour E irradiance occlusion "
@@ -892,10 +921,10 @@ void shading_text(std::ostringstream& o, const FrameSetup& s, const Recording& r
               << " -> coat clearcoat F_coat (A + B) prefiltered occlusion " << vec(t.coat_specular)
               << "; diffuse and specular above times 1 - clearcoat F_coat = " << num(t.coat_attenuation) << "\n";
             o << "    occlusion " << num(t.occlusion) << "; diffuse + specular" << (t.sheen ? " + sheen" : "")
-              << " + coat = " << vec(sh.ambient) << "\n";
+              << " + coat" << (t.transmission ? " + transmission" : "") << " = " << vec(sh.ambient) << "\n";
         } else {
-            o << "    occlusion " << num(t.occlusion) << "; diffuse + specular" << (t.sheen ? " + sheen" : "") << " = "
-              << vec(sh.ambient) << "\n";
+            o << "    occlusion " << num(t.occlusion) << "; diffuse + specular" << (t.sheen ? " + sheen" : "")
+              << (t.transmission ? " + transmission" : "") << " = " << vec(sh.ambient) << "\n";
         }
     } else {
         o << "  ambient " << vec(s.settings.ambient) << " * albedo * occlusion = " << vec(sh.ambient) << "\n";

@@ -391,6 +391,15 @@ void add_render_flags(FlagSet& set, RenderParse& st, bool render_only) {
                  "node's transform and animation; perspective or orthographic. The image's aspect (`--size`) is "
                  "used, not the file's aspectRatio. `--near`/`--far` override its planes.";
         c.hints = {"cam", "view-camera", "file-camera", "viewpoint"};
+        Flag& va = set.value({"--variant"}, "NAME", "a material variant of the file", "the default materials", {""},
+                             [&o](const std::string& flag, const std::string& v) {
+                                 if (v.empty()) bad_value(flag, v, "expected a variant's name or index");
+                                 o.variant = v;
+                             });
+        va.help = "Draws the model's KHR_materials_variants variant NAME (or its index; `render --list` shows "
+                  "them): each primitive with a mapping for it takes that material, the others keep their own. "
+                  "A name the model does not have is an error listing the variants it has.";
+        va.hints = {"material-variant", "variants", "materials", "look", "colorway"};
     }
     if (wanted("--fps")) {
         Flag& f = set.value({"--fps"}, "F", "frames a second of a sequence", "", {"0", "-1", "nan", "2e6"},
@@ -404,8 +413,9 @@ void add_render_flags(FlagSet& set, RenderParse& st, bool render_only) {
                  "`--time` + i / F seconds. Needs `--frames`.";
         f.hints = {"framerate", "frame-rate", "rate", "sequence"};
         Flag& l = set.toggle({"--list"}, "print the model's contents", [&o] { o.list = true; });
-        l.help = "Prints the model's meshes, materials, cameras, animations (name, duration, channels), skins and "
-                 "the extensions it uses and requires, then exits without rendering.";
+        l.help = "Prints the model's meshes, materials, cameras, animations (name, duration, channels), skins, "
+                 "material variants (with how many primitives each remaps) and the extensions it uses and "
+                 "requires, then exits without rendering.";
         l.hints = {"info", "inspect", "contents", "describe", "ls"};
     }
     if (wanted("--frames")) {
@@ -558,9 +568,10 @@ std::vector<HelpRow> render_help_rows(bool render_only) {
                         "--fps: frames in time; FILE needs %04d"});
         rows.push_back({{"--frame-range", "--repeat"}, "frames A..B only; N times, print frame_ms"});
         rows.push_back({{"--stats", "--pixel"}, "per-stage counters and times; probe a pixel"});
-        rows.push_back({{"--allow-outside-paths", "--list"}, "files outside the model's folder; list it"});
+        rows.push_back({{"--allow-outside-paths", "--list", "--variant"}, "outside paths; list it; variant"});
     } else {
         rows.push_back({{"--pixel"}, "explain one pixel and exit"});
+        rows.push_back({{"--variant"}, ""});
     }
     rows.push_back({{"--help", "--version"}, render_only ? "exit codes: 0 ok, 1 bad file or write, 2 bad usage"
                                                          : "exit codes: 0 ok, 1 bad file or a failed command, "

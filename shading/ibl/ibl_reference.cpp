@@ -23,7 +23,7 @@ glm::vec3 integrate_environment(const Environment& env, const BrdfInputs& in_, B
     const int n_env = env.has_sampler() ? samples / 3 : 0;
     const int rest = samples - n_env;
     int n_ggx = std::min(rest, int(std::lround(rest * (0.5 + 0.5 * metal))));
-    const int n_cos = rest - n_ggx;
+    int n_cos = rest - n_ggx;
     // KHR_materials_clearcoat: half of the GGX share samples the coat's lobe
     // (its own normal and roughness); without a coat nothing changes.
     const bool coat = in.clearcoat > 0.0f;
@@ -33,6 +33,32 @@ glm::vec3 integrate_environment(const Environment& env, const BrdfInputs& in_, B
     const Frame frame_c(coat ? nc : n);
     const int n_coat = coat ? n_ggx / 2 : 0;
     n_ggx -= n_coat;
+    // KHR_materials_transmission: the transmitted share of the diffuse's
+    // samples goes to the transmission lobe, the reflection lobe of the
+    // transmission roughness mirrored through the surface's plane (the lobe
+    // evaluate_brdf() gives a light behind the surface). What it sees is the
+    // environment along the lobe's direction turned as -v is turned to
+    // transmission_direction() (no turn for a thin wall), as the split sum
+    // looks it up.
+    const bool tr = in.transmission > 0.0f;
+    const double rt = std::clamp(double(in.transmission_roughness), double(kMinPerceptualRoughness), 1.0);
+    const double alpha_t = rt * rt;
+    const int n_tr = tr ? std::min(n_cos, int(std::lround(n_cos * std::clamp(double(in.transmission), 0.0, 1.0)))) : 0;
+    n_cos -= n_tr;
+    // The turn: Rodrigues' rotation taking a = -v to b.
+    glm::dvec3 turn_axis(0.0);
+    double turn_cos = 1.0, turn_sin = 0.0;
+    if (tr && in.thickness > 0.0f) {
+        const glm::dvec3 a = -v, b(transmission_direction(in.n, in.v, in.ior, in.thickness));
+        const glm::dvec3 c = glm::cross(a, b);
+        turn_sin = glm::length(c);
+        turn_cos = glm::dot(a, b);
+        if (turn_sin > 1e-12) turn_axis = c / turn_sin;
+    }
+    auto turned = [&](const glm::dvec3& l) {
+        if (!(turn_sin > 1e-12)) return l;
+        return l * turn_cos + glm::cross(turn_axis, l) * turn_sin + turn_axis * (glm::dot(turn_axis, l) * (1.0 - turn_cos));
+    };
 
     // sum_s N_s pdf_s(l) for a direction l.
     auto mixture_pdf = [&](const glm::dvec3& l) {
@@ -49,6 +75,16 @@ glm::vec3 integrate_environment(const Environment& env, const BrdfInputs& in_, B
             }
         }
         if (n_env > 0) p += n_env * env.direction_pdf(glm::vec3(l));
+        if (n_tr > 0) {  // the GGX density at l mirrored (its samples may land in front too)
+            const glm::dvec3 lm = l - n * (2.0 * NoL);
+            const glm::dvec3 hsum = lm + v;
+            const double len = glm::length(hsum);
+            if (len > 0.0) {
+                const glm::dvec3 h = hsum / len;
+                const double VoH = glm::dot(v, h), NoH = glm::dot(n, h);
+                if (VoH > 0.0 && NoH > 0.0) p += n_tr * D_GGX_d(NoH, alpha_t) * NoH / (4.0 * VoH);
+            }
+        }
         if (n_coat > 0) {
             const glm::dvec3 hsum = l + v;
             const double len = glm::length(hsum);
@@ -63,7 +99,8 @@ glm::vec3 integrate_environment(const Environment& env, const BrdfInputs& in_, B
 
     glm::dvec3 sum(0.0);
     auto add = [&](const glm::dvec3& l) {
-        if (!(glm::dot(n, l) > 0.0) && !(coat && glm::dot(nc, l) > 0.0)) return;
+        const bool behind = tr && glm::dot(n, l) < 0.0;
+        if (!(glm::dot(n, l) > 0.0) && !(coat && glm::dot(nc, l) > 0.0) && !behind) return;
         const double p = mixture_pdf(l);
         if (!(p > 0.0)) return;
         in.l = glm::vec3(l);
@@ -71,15 +108,30 @@ glm::vec3 integrate_environment(const Environment& env, const BrdfInputs& in_, B
         const glm::vec3 L = env.radiance(in.l);
         sum += glm::dvec3(t.f * L) * (double(t.NoL) / p);
         if (t.coat) sum += glm::dvec3(L) * (double(t.coat_specular) * double(t.coat_NoL) / p);
+        if (behind && t.tr_NoL > 0.0f) {
+            const glm::vec3 Lt = env.radiance(glm::vec3(turned(l)));
+            sum += glm::dvec3(t.tr_f * Lt) * (double(t.tr_NoL) / p);
+        }
     };
     for (int j = 0; j < n_ggx; ++j) {
         const glm::dvec3 h = frame.to_world(sample_ggx_half(hammersley(std::uint32_t(j), std::uint32_t(n_ggx)), alpha));
+        // A half vector facing away from v reflects v below the surface, where
+        // mixture_pdf() counts no density for it: with transmission, which
+        // evaluates directions there, it is a lost sample.
+        if (tr && !(glm::dot(v, h) > 0.0)) continue;
         add(2.0 * glm::dot(v, h) * h - v);
     }
     for (int j = 0; j < n_coat; ++j) {
         const glm::dvec3 h =
             frame_c.to_world(sample_ggx_half(hammersley(std::uint32_t(j), std::uint32_t(n_coat)), alpha_c));
+        if (tr && !(glm::dot(v, h) > 0.0)) continue;  // as above
         add(2.0 * glm::dot(v, h) * h - v);
+    }
+    for (int j = 0; j < n_tr; ++j) {
+        const glm::dvec3 h = frame.to_world(sample_ggx_half(hammersley(std::uint32_t(j), std::uint32_t(n_tr)), alpha_t));
+        if (!(glm::dot(v, h) > 0.0)) continue;  // as above
+        const glm::dvec3 lm = 2.0 * glm::dot(v, h) * h - v;
+        add(lm - n * (2.0 * glm::dot(n, lm)));  // mirrored through the surface's plane
     }
     for (int j = 0; j < n_cos; ++j)
         add(frame.to_world(sample_cosine(hammersley(std::uint32_t(j), std::uint32_t(n_cos)))));
