@@ -875,6 +875,8 @@ void step_seeds() {
     put("step", "overview", "help\nframe\ntri 0\ntile 0 0\npixel 24 16\n");
     put("step", "stages", "stage depth\nstage coverage\nupto 3\nverify\n");
     put("step", "errors", "tri -1\ntile 99 0\npixel 48 0\nupto x\nstage nope\nbogus\n# comment\nquit\n");
+    put("step", "views", "draws\ndraw 0\ntextures\ntexel 0 0 1 1\njson texel 0 0 0 0\nvertices 0 0 4\n"
+                         "json tile 0 0 pixel 1 1\nupto 2\npixel 24 16\nupto all\npixel 24 16\ntexel 0 9 0 0\n");
 }
 
 } // namespace

@@ -20,7 +20,10 @@ built=$(date +%s)
 export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:check_initialization_order=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:suppressions=$PWD/tests/ubsan.supp"
 # Every test but `examples` (an install and a consumer build: no code of ours
-# runs there that the suite does not run).
-ctest --test-dir build-asan -j2 --output-on-failure -E '^examples$'
+# runs there that the suite does not run), `docs` (the pages against what the
+# programs print: the same sessions and renders the other suites run) and
+# `browser` (the page's behaviour in Chromium; every endpoint it calls, and
+# every attack on them, is the `serve` test, which runs here).
+ctest --test-dir build-asan -j2 --output-on-failure -E '^(examples|docs|browser)$'
 
 echo "sanitize step: build $((built - start)) s, tests $(($(date +%s) - built)) s"

@@ -745,6 +745,10 @@ def slow_reader_checks(port):
     server, never in a worker, so a page load is answered (within 3 s) while
     all 8 are connected; they are closed after 5 s without reading."""
     pid = server_pid(port)
+    # What the answers and the page make once and keep is made before the
+    # first measure: what follows measures the waiting answers alone.
+    assert request(port, "/api/tile?x=2&y=1")[0] == 200
+    page_load(port)
     before = rss_kib(pid)
     one = ("GET /api/tile?x=2&y=1 HTTP/1.1\r\nHost: 127.0.0.1:%d\r\n\r\n" % port).encode()
     conns, connected = [], []
@@ -788,14 +792,17 @@ def slow_reader_checks(port):
     assert "01" not in states, ("clients that read nothing were still connected after 60 s", states)
     check_good(port)
     # The server gives memory back when idle (a check every 0.1 s): on a
-    # loaded machine that may take more than one look.
+    # loaded machine that may take more than one look. AddressSanitizer's
+    # allocator keeps freed memory in its quarantine instead, so there the
+    # bound while they wait is the check.
+    sanitized = "libasan" in open("/proc/%d/maps" % pid).read()
     deadline = time.monotonic() + 10
     while True:
         time.sleep(0.5)
         after = rss_kib(pid)
-        if after - before < 8 * 1024 or time.monotonic() > deadline:
+        if sanitized or after - before < 8 * 1024 or time.monotonic() > deadline:
             break
-    assert after - before < 8 * 1024, ("VmRSS %d KiB before, %d after" % (before, after))
+    assert sanitized or after - before < 8 * 1024, ("VmRSS %d KiB before, %d after" % (before, after))
     print("hostile: 8 clients not reading 19 answers each: page load %.2f s with %d of them open, "
           "VmRSS %d -> %d -> %d KiB" % (took, still_open, before, during, after), flush=True)
     return 8 * 19
