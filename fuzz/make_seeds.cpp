@@ -414,6 +414,33 @@ void gltf_seeds() {
         R"("emissiveTexture":{"index":0,"extensions":{"KHR_texture_transform":{"texCoord":7}}}},)"
         R"({"extensions":{"KHR_materials_unlit":{}},"pbrMetallicRoughness":{"baseColorFactor":[0.2,0.4,0.6,0.5],)"
         R"("baseColorTexture":{"index":0}},"alphaMode":"BLEND"}]})");
+    // The material extensions (specular, clearcoat with its own normal map,
+    // sheen, transmission, volume, each with its textures and transforms) and
+    // KHR_materials_variants' mappings, one of them out of range.
+    put("gltf", "material-extensions.gltf",
+        R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_materials_specular","KHR_materials_clearcoat",)"
+        R"("KHR_materials_sheen","KHR_materials_transmission","KHR_materials_volume","KHR_materials_variants",)"
+        R"("KHR_texture_transform"],)"
+        R"("extensions":{"KHR_materials_variants":{"variants":[{"name":"red"},{"name":"glass"},{}]}},)"
+        R"("buffers":[{"uri":"b.bin","byteLength":256}],)"
+        R"("bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":24}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},)"
+        R"({"bufferView":1,"componentType":5126,"count":3,"type":"VEC2"}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1},"material":0,)"
+        R"("extensions":{"KHR_materials_variants":{"mappings":[{"material":1,"variants":[0]},)"
+        R"({"material":2,"variants":[1,5]},{"material":9,"variants":[2]}]}}}]}],)"
+        R"("nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],)"
+        R"("images":[{"uri":"t.png"}],"textures":[{"source":0}],)"
+        R"("materials":[{"extensions":{"KHR_materials_specular":{"specularFactor":0.5,"specularColorFactor":[1,0.5,0],)"
+        R"("specularTexture":{"index":0},"specularColorTexture":{"index":0,"texCoord":1}},)"
+        R"("KHR_materials_sheen":{"sheenColorFactor":[0.9,0.5,0.8],"sheenRoughnessFactor":0.5,)"
+        R"("sheenColorTexture":{"index":0},"sheenRoughnessTexture":{"index":0}}}},)"
+        R"({"extensions":{"KHR_materials_clearcoat":{"clearcoatFactor":1,"clearcoatRoughnessFactor":0.2,)"
+        R"("clearcoatTexture":{"index":0},"clearcoatRoughnessTexture":{"index":0},)"
+        R"("clearcoatNormalTexture":{"index":0,"scale":2,"extensions":{"KHR_texture_transform":{"rotation":1}}}}}},)"
+        R"({"extensions":{"KHR_materials_transmission":{"transmissionFactor":1,"transmissionTexture":{"index":0}},)"
+        R"("KHR_materials_volume":{"thicknessFactor":0.5,"thicknessTexture":{"index":0},)"
+        R"("attenuationDistance":2,"attenuationColor":[1,0.5,0.25]}}}]})");
     put("gltf", "min-version.gltf",
         R"({"asset":{"version":"2.1","minVersion":"2.1"},"buffers":[{"uri":"b.bin","byteLength":256}],)"
         R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
