@@ -97,4 +97,36 @@ struct GltfWriter {
     }
 };
 
+inline int add_material(GltfWriter& g, const nlohmann::json& m) {
+    g.doc["materials"].push_back(m);
+    return int(g.doc["materials"].size()) - 1;
+}
+
+// A UV sphere of radius 1 about the origin (normals, UVs), one primitive
+// with `material`: the lobes' whole angular range in one mesh.
+inline int add_sphere(GltfWriter& g, int material, int nu = 24, int nv = 12) {
+    const double pi = 3.14159265358979323846;
+    std::vector<float> pos, nor, uv;
+    std::vector<std::uint16_t> ind;
+    for (int j = 0; j <= nv; ++j)
+        for (int i = 0; i <= nu; ++i) {
+            const double th = pi * j / nv, ph = 2.0 * pi * i / nu;
+            const float x = float(std::sin(th) * std::cos(ph)), y = float(std::cos(th)), z = float(std::sin(th) * std::sin(ph));
+            pos.insert(pos.end(), {x, y, z});
+            nor.insert(nor.end(), {x, y, z});
+            uv.insert(uv.end(), {float(i) / float(nu), float(j) / float(nv)});
+        }
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            const std::uint16_t a = std::uint16_t(j * (nu + 1) + i), b = std::uint16_t(a + nu + 1);
+            ind.insert(ind.end(), {a, std::uint16_t(a + 1), b, std::uint16_t(a + 1), std::uint16_t(b + 1), b});
+        }
+    const nlohmann::json attrs = {{"POSITION", g.floats(pos, "VEC3", 3)}, {"NORMAL", g.floats(nor, "VEC3", 3)},
+                                  {"TEXCOORD_0", g.floats(uv, "VEC2", 2)}};
+    const int indices = g.u16(ind, "SCALAR", 1);
+    g.doc["meshes"].push_back(
+        {{"primitives", nlohmann::json::array({{{"attributes", attrs}, {"indices", indices}, {"material", material}}})}});
+    return int(g.doc["meshes"].size()) - 1;
+}
+
 } // namespace prast::gltf_test

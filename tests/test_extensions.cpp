@@ -44,10 +44,6 @@ int add_quad(GltfWriter& g, int material, float z = 0.0f, const json& extra = js
     return int(g.doc["meshes"].size()) - 1;
 }
 
-int add_material(GltfWriter& g, const json& m) {
-    g.doc["materials"].push_back(m);
-    return int(g.doc["materials"].size()) - 1;
-}
 
 // One node per mesh, then light nodes: each {light index, translation}.
 void finish_scene(GltfWriter& g, const std::vector<std::pair<int, glm::vec3>>& light_nodes = {}) {

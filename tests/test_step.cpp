@@ -213,10 +213,6 @@ int add_quad(GltfWriter& g, float z, const json& extra_attributes, int material,
     return int(g.doc["meshes"].size()) - 1;
 }
 
-int add_material(GltfWriter& g, const json& m) {
-    g.doc["materials"].push_back(m);
-    return int(g.doc["materials"].size()) - 1;
-}
 
 std::string write_gltf(CliSandbox& box, const GltfWriter& g, const std::string& name) {
     write_text(box.path(name), g.text());

@@ -115,34 +115,7 @@ bool close(const glm::vec3& a, const glm::vec3& b, float rel) {
 
 // ---- Files
 
-int add_material(GltfWriter& g, const json& m) {
-    g.doc["materials"].push_back(m);
-    return int(g.doc["materials"].size()) - 1;
-}
 
-int add_sphere(GltfWriter& g, int material) {
-    const int nu = 24, nv = 12;
-    std::vector<float> pos, nor, uv;
-    std::vector<std::uint16_t> ind;
-    for (int j = 0; j <= nv; ++j)
-        for (int i = 0; i <= nu; ++i) {
-            const double th = kPi * j / nv, ph = 2.0 * kPi * i / nu;
-            const float x = float(std::sin(th) * std::cos(ph)), y = float(std::cos(th)), z = float(std::sin(th) * std::sin(ph));
-            pos.insert(pos.end(), {x, y, z});
-            nor.insert(nor.end(), {x, y, z});
-            uv.insert(uv.end(), {float(i) / nu, float(j) / nv});
-        }
-    for (int j = 0; j < nv; ++j)
-        for (int i = 0; i < nu; ++i) {
-            const std::uint16_t a = std::uint16_t(j * (nu + 1) + i), b = std::uint16_t(a + nu + 1);
-            ind.insert(ind.end(), {a, std::uint16_t(a + 1), b, std::uint16_t(a + 1), std::uint16_t(b + 1), b});
-        }
-    const json attrs = {{"POSITION", g.floats(pos, "VEC3", 3)}, {"NORMAL", g.floats(nor, "VEC3", 3)},
-                        {"TEXCOORD_0", g.floats(uv, "VEC2", 2)}};
-    const int indices = g.u16(ind, "SCALAR", 1);
-    g.doc["meshes"].push_back({{"primitives", json::array({{{"attributes", attrs}, {"indices", indices}, {"material", material}}})}});
-    return int(g.doc["meshes"].size()) - 1;
-}
 
 json glass(const json& ext = json()) {
     json m = {{"pbrMetallicRoughness", {{"baseColorFactor", {0.9, 0.7, 0.5, 1}}, {"metallicFactor", 0.0},
