@@ -106,7 +106,9 @@ private:
         const std::size_t csize = component_size(a.componentType);
         if (a.type != type || ncomp == 0) fail(what + ": wrong type");
         if (csize == 0) fail(what + ": unsupported componentType " + std::to_string(a.componentType));
-        if (integers && (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || a.normalized))
+        if (integers && (a.normalized || (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                          a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                          a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)))
             fail(what + ": must be unsigned integers");
         if (a.count > kMaxCount) fail(what + ": absurd count " + std::to_string(a.count));
         if (a.bufferView < 0) {

@@ -94,18 +94,13 @@ public:
     // Runs `exe args...` in work(), after the shell commands `setup` (e.g. a ulimit).
     CliRun run_exe(const std::string& exe, const std::vector<std::string>& args,
                    const std::string& setup = "") const {
-        std::string cmd = "cd " + shell_quote(work().string()) + " && " + (setup.empty() ? "" : setup + " && ") +
-                          shell_quote(exe);
-        for (const std::string& a : args) cmd += " " + shell_quote(a);
-        cmd += " >" + shell_quote((root_ / "stdout.txt").string()) + " 2>" +
-               shell_quote((root_ / "stderr.txt").string()) + " </dev/null";
-        const int status = std::system(cmd.c_str());
-        CliRun r;
-        if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
-        else if (status != -1 && WIFSIGNALED(status)) r.code = 128 + WTERMSIG(status);
-        r.out = read_text(root_ / "stdout.txt");
-        r.err = read_text(root_ / "stderr.txt");
-        return r;
+        return run(exe, args, setup, "/dev/null");
+    }
+    // As run_exe, with `input` as standard input (step reads its commands there).
+    CliRun run_exe_with_input(const std::string& exe, const std::vector<std::string>& args,
+                              const std::string& input) const {
+        write_text(root_ / "stdin.txt", input);
+        return run(exe, args, "", (root_ / "stdin.txt").string());
     }
 
     // Names of the files (and directories) in work(), sorted.
@@ -117,6 +112,22 @@ public:
     }
 
 private:
+    CliRun run(const std::string& exe, const std::vector<std::string>& args, const std::string& setup,
+               const std::string& stdin_path) const {
+        std::string cmd = "cd " + shell_quote(work().string()) + " && " + (setup.empty() ? "" : setup + " && ") +
+                          shell_quote(exe);
+        for (const std::string& a : args) cmd += " " + shell_quote(a);
+        cmd += " >" + shell_quote((root_ / "stdout.txt").string()) + " 2>" +
+               shell_quote((root_ / "stderr.txt").string()) + " <" + shell_quote(stdin_path);
+        const int status = std::system(cmd.c_str());
+        CliRun r;
+        if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
+        else if (status != -1 && WIFSIGNALED(status)) r.code = 128 + WTERMSIG(status);
+        r.out = read_text(root_ / "stdout.txt");
+        r.err = read_text(root_ / "stderr.txt");
+        return r;
+    }
+
     fs::path root_;
 };
 

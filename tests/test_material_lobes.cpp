@@ -804,15 +804,10 @@ TEST_CASE("step: the breakdown shows the coat and specular terms, its srgb8 equa
                 commands += "pixel " + std::to_string(x) + " " + std::to_string(y) + "\n";
             }
         commands += "verify\n";
-        write_text(box.path("stdin.txt"), commands);
-        std::string cmd = "cd " + shell_quote(box.work().string()) + " && " + shell_quote(PRAST_STEP_EXE);
-        for (const std::string& a : flags) cmd += " " + shell_quote(a);
-        cmd += " <" + shell_quote(box.path("stdin.txt")) + " >" + shell_quote(box.path("stdout.txt")) + " 2>" +
-               shell_quote(box.path("stderr.txt"));
-        const int status = std::system(cmd.c_str());
-        const std::string out = read_text(box.path("stdout.txt"));
-        INFO(out.substr(0, 4000) << read_text(box.path("stderr.txt")));
-        REQUIRE(status == 0);
+        const CliRun sr = box.run_exe_with_input(PRAST_STEP_EXE, flags, commands);
+        const std::string& out = sr.out;
+        INFO(out.substr(0, 4000) << sr.err);
+        REQUIRE(sr.code == 0);
         CHECK(out.find("verify: ok, all identical") != std::string::npos);
         CHECK(out.find("KHR_materials_specular: specular 0.7") != std::string::npos);
         CHECK(out.find("KHR_materials_clearcoat: clearcoat 0.9") != std::string::npos);

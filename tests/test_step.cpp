@@ -51,19 +51,7 @@ const std::string kTranscripts = std::string(PRAST_SOURCE_DIR) + "/tests/step/";
 
 // Runs step in the sandbox with `commands` on standard input.
 CliRun run_step(CliSandbox& box, const std::vector<std::string>& args, const std::string& commands) {
-    const fs::path dir = box.work().parent_path();
-    write_text(dir / "stdin.txt", commands);
-    std::string cmd = "cd " + shell_quote(box.work().string()) + " && " + shell_quote(kStep);
-    for (const std::string& a : args) cmd += " " + shell_quote(a);
-    cmd += " <" + shell_quote((dir / "stdin.txt").string()) + " >" + shell_quote((dir / "stdout.txt").string()) +
-           " 2>" + shell_quote((dir / "stderr.txt").string());
-    const int status = std::system(cmd.c_str());
-    CliRun r;
-    if (status != -1 && WIFEXITED(status)) r.code = WEXITSTATUS(status);
-    else if (status != -1 && WIFSIGNALED(status)) r.code = 128 + WTERMSIG(status);
-    r.out = read_text(dir / "stdout.txt");
-    r.err = read_text(dir / "stderr.txt");
-    return r;
+    return box.run_exe_with_input(kStep, args, commands);
 }
 
 // stb_image_write's RGBE encoding and stb_image's decoding of it: what a
