@@ -354,6 +354,18 @@ TEST_CASE("README.md: at most 300 lines, opening with the two set-up commands of
     CHECK(commands[1].find("ctest --test-dir build") != std::string::npos);
 }
 
+TEST_CASE("docs/default.png is what the README's first command draws (render with no arguments)") {
+    CliSandbox box;
+    const CliRun r = box.run_exe(kRender, {"-o", "default.png"});
+    REQUIRE(r.code == 0);
+    const Rgb8 got = load_rgb8(box.path("default.png"));
+    const Rgb8 want = load_rgb8(kSource + "/docs/default.png");
+    REQUIRE(!got.empty());
+    CHECK(got.width == want.width);
+    CHECK(got.height == want.height);
+    CHECK_MESSAGE(got.rgb == want.rgb, "regenerate it with ./build/render -o docs/default.png");
+}
+
 TEST_CASE("README.md: the five render examples run and draw the pictures they are named after") {
     const Page page = parse_page(source_text("README.md"));
     std::vector<std::string> examples;
