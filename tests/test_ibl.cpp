@@ -25,28 +25,16 @@
 #include "shading/ibl/prefilter.h"
 #include "renderer/scene_renderer.h"
 #include "shading/surface.h"
+#include "tests/ibl_test_util.h"
 
 using namespace prast;
 namespace fs = std::filesystem;
+using prast::test::IblPoint;
+using prast::test::make_env;
+using prast::test::make_ibl_point;
+using prast::test::pool2;
 
 namespace {
-
-ThreadPool& pool2() {
-    static ThreadPool p(2);
-    return p;
-}
-
-// An equirect image whose texel centres take fn(direction).
-Image make_env(int w, const std::function<glm::vec3(const glm::dvec3&)>& fn) {
-    Image img;
-    img.width = w;
-    img.height = w / 2;
-    img.rgba.assign(std::size_t(img.width) * img.height * 4, 1.0f);
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x)
-            img.set(x, y, glm::vec4(fn(equirect_direction((x + 0.5) / img.width, (y + 0.5) / img.height)), 1.0f));
-    return img;
-}
 
 Image uniform_env(float L, int w = 64) {
     return make_env(w, [L](const glm::dvec3&) { return glm::vec3(L); });
@@ -80,34 +68,9 @@ const Environment& shared_env(const char* which) {
     return std::strcmp(which, "uniform") == 0 ? uniform1 : procedural;
 }
 
+// The tables by DFG model: the ones the BRDF models read (built once).
 const DfgTable& shared_dfg(DfgModel m) {
-    static const DfgTable ibl = DfgTable::build(DfgModel::SchlickIbl, pool2());
-    static const DfgTable correlated = DfgTable::build(DfgModel::HeightCorrelated, pool2());
-    return m == DfgModel::SchlickIbl ? ibl : correlated;
-}
-
-// A shading point with normal n seen from direction v (both unit).
-struct Point {
-    MaterialSample ms;
-    SurfacePoint sp;
-    ShadingContext ctx;
-};
-
-Point make_point(const Environment& env, const glm::vec3& n, const glm::vec3& v, glm::vec3 albedo, float metallic,
-                 float roughness, bool energy, BrdfModel model = BrdfModel::Default) {
-    Point p;
-    p.ms.N = n;
-    p.ms.N_geom = n;
-    p.ms.albedo = albedo;
-    p.ms.metallic = metallic;
-    p.ms.roughness = roughness;
-    p.sp.P = glm::vec3(0.0f);
-    p.ctx.eye = v * 5.0f;
-    p.ctx.model = model;
-    p.ctx.env = &env;
-    p.ctx.dfg_ibl = &shared_dfg(model == BrdfModel::Gltf ? DfgModel::HeightCorrelated : DfgModel::SchlickIbl);
-    p.ctx.energy = energy;
-    return p;
+    return prast::test::dfg_for(m == DfgModel::SchlickIbl ? BrdfModel::Default : BrdfModel::Gltf);
 }
 
 // v at angle acos(cos_v) from n, turned by phi about n.
@@ -232,12 +195,12 @@ TEST_CASE("white furnace: split sum and reference under a uniform sky of radianc
                 for (double cos_v : kCosView) {
                     const glm::vec3 v = view_about(n, cos_v, 0.3);
                     CAPTURE(std::string(brdf_model_name(model))); CAPTURE(metallic); CAPTURE(r); CAPTURE(cos_v);
-                    Point plain = make_point(env, n, v, glm::vec3(1.0f), metallic, r, false, model);
+                    IblPoint plain = make_ibl_point(env, n, v, glm::vec3(1.0f), metallic, r, false, model);
                     const glm::vec3 lp = shade_surface(plain.ms, plain.sp, plain.ctx);
                     min_plain = std::min(min_plain, double(lp.x));
                     max_plain = std::max(max_plain, double(lp.x));
                     if (cos_v >= 0.7) max_plain_near = std::max(max_plain_near, double(lp.x));
-                    Point energy = make_point(env, n, v, glm::vec3(1.0f), metallic, r, true, model);
+                    IblPoint energy = make_ibl_point(env, n, v, glm::vec3(1.0f), metallic, r, true, model);
                     const glm::vec3 le = shade_surface(energy.ms, energy.sp, energy.ctx);
                     worst_energy = std::max(worst_energy, std::fabs(double(le.x) - 1.0));
                     CHECK(std::fabs(le.x - 1.0f) < 2e-3f);
@@ -323,7 +286,7 @@ TEST_CASE("a mirror returns the environment") {
         const glm::vec3 n = glm::vec3(nd);
         for (double cos_v : {1.0, 0.8, 0.5, 0.3}) {
             const glm::vec3 v = view_about(n, cos_v, 1.0 + i);
-            Point p = make_point(env, n, v, glm::vec3(1.0f), 1.0f, 0.0f, true);
+            IblPoint p = make_ibl_point(env, n, v, glm::vec3(1.0f), 1.0f, 0.0f, true);
             const IblTerms t = ibl_terms(p.ms, p.sp, p.ctx);
             const glm::vec3 mirror = n * (2.0f * glm::dot(n, v)) - v;
             const glm::vec3 expect = env.radiance(mirror);
@@ -333,7 +296,7 @@ TEST_CASE("a mirror returns the environment") {
             const glm::vec3 got = shade_surface(p.ms, p.sp, p.ctx);
             const double e = std::fabs(double(lum(got)) - lum(expect)) / std::max(1e-3, double(lum(expect)));
             worst_energy = std::max(worst_energy, e);
-            Point q = make_point(env, n, v, glm::vec3(1.0f), 1.0f, 0.0f, false);
+            IblPoint q = make_ibl_point(env, n, v, glm::vec3(1.0f), 1.0f, 0.0f, false);
             const glm::vec3 plain = shade_surface(q.ms, q.sp, q.ctx);
             worst_plain = std::max(worst_plain, std::fabs(double(lum(plain)) - lum(expect)) /
                                                     std::max(1e-3, double(lum(expect))));
@@ -481,7 +444,7 @@ TEST_CASE("split sum against the reference integral") {
                 for (double cos_v : {0.95, 0.7, 0.4, 0.15}) {
                     for (const glm::vec3& n : normals) {
                         const glm::vec3 v = view_about(n, cos_v, 0.7);
-                        Point p = make_point(*e.env, n, v, glm::vec3(0.9f, 0.6f, 0.4f), metallic, r, false);
+                        IblPoint p = make_ibl_point(*e.env, n, v, glm::vec3(0.9f, 0.6f, 0.4f), metallic, r, false);
                         const IblTerms t = ibl_terms(p.ms, p.sp, p.ctx);
                         const glm::vec3 split = t.diffuse + t.specular;
                         const glm::vec3 ref = ibl_reference(p.ms, p.sp, p.ctx, 8192);

@@ -30,20 +30,18 @@
 #include "shading/surface.h"
 #include "tests/cli_util.h"
 #include "tests/gltf_writer.h"
+#include "tests/ibl_test_util.h"
 #include "tests/scratch.h"
+#include "tests/step_check.h"
 
 using namespace prast;
 using prast::gltf_test::GltfWriter;
 using json = nlohmann::json;
+using namespace prast::test;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-ThreadPool& pool2() {
-    static ThreadPool p(2);
-    return p;
-}
 
 // ---- BRDF quadrature (as tests/test_brdf.cpp): v in the xz plane, f symmetric in y.
 
@@ -125,62 +123,6 @@ double v_correlated(double NoV, double NoL, double a) {
 
 // ---- Image-based lighting
 
-Image make_env(int w, glm::vec3 (*fn)(const glm::dvec3&)) {
-    Image img;
-    img.width = w;
-    img.height = w / 2;
-    img.rgba.assign(std::size_t(img.width) * img.height * 4, 1.0f);
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x)
-            img.set(x, y, glm::vec4(fn(equirect_direction((x + 0.5) / img.width, (y + 0.5) / img.height)), 1.0f));
-    return img;
-}
-
-// A sky with structure for every lobe: a gradient, a soft sun (peak 20,
-// about 6 degrees wide), a warm ground.
-glm::vec3 sky(const glm::dvec3& d) {
-    const glm::dvec3 sun = glm::normalize(glm::dvec3(0.5, 0.5, -0.6));
-    const double up = std::max(d.y, 0.0);
-    glm::dvec3 c = d.y > 0.0 ? glm::mix(glm::dvec3(0.8, 0.85, 0.9), glm::dvec3(0.15, 0.3, 0.7), std::sqrt(up))
-                             : glm::dvec3(0.3, 0.22, 0.15) * (1.0 + 0.5 * d.y);
-    const double a = std::acos(std::clamp(glm::dot(d, sun), -1.0, 1.0));
-    c += glm::dvec3(20.0, 18.0, 15.0) * std::exp(-a * a / (2.0 * 0.05 * 0.05));
-    return glm::vec3(c);
-}
-glm::vec3 white(const glm::dvec3&) { return glm::vec3(1.0f); }
-
-const Environment& shared_env(bool uniform) {
-    static const Environment u = Environment::build(make_env(64, white), {1.0f, 0.0f, true}, pool2());
-    static const Environment s = Environment::build(make_env(256, sky), {1.0f, 0.0f, true}, pool2());
-    return uniform ? u : s;
-}
-const DfgTable& shared_dfg(BrdfModel m) {
-    static const DfgTable ibl = DfgTable::build(DfgModel::SchlickIbl, pool2());
-    static const DfgTable correlated = DfgTable::build(DfgModel::HeightCorrelated, pool2());
-    return m == BrdfModel::Gltf ? correlated : ibl;
-}
-
-struct Point {
-    MaterialSample ms;
-    SurfacePoint sp;
-    ShadingContext ctx;
-};
-
-Point make_point(const Environment& env, const glm::vec3& n, const glm::vec3& v, glm::vec3 albedo, float metallic,
-                 float roughness, bool energy, BrdfModel model) {
-    Point p;
-    p.ms.N = p.ms.N_geom = p.ms.clearcoat_N = n;
-    p.ms.albedo = albedo;
-    p.ms.metallic = metallic;
-    p.ms.roughness = roughness;
-    p.ctx.eye = v * 5.0f;
-    p.ctx.model = model;
-    p.ctx.env = &env;
-    p.ctx.dfg_ibl = &shared_dfg(model);
-    p.ctx.energy = energy;
-    return p;
-}
-
 glm::vec3 view_about(const glm::vec3& n, double cos_v, double phi) {
     const Frame f{glm::dvec3(n)};
     const double s = std::sqrt(std::max(0.0, 1.0 - cos_v * cos_v));
@@ -199,8 +141,6 @@ int add_quad(GltfWriter& g, int material, float z = 0.0f) {
     g.doc["meshes"].push_back({{"primitives", json::array({{{"attributes", attrs}, {"indices", ind}, {"material", material}}})}});
     return int(g.doc["meshes"].size()) - 1;
 }
-
-
 
 // An 8x8 RGBA PNG of a smooth pattern, so maps vary over the surface.
 std::vector<unsigned char> pattern_png(int seed) {
@@ -242,7 +182,7 @@ std::vector<float> draw(const Scene& scene, bool env, int threads = 1) {
     point.position = {-1.0f, 1.5f, 2.0f};
     point.radiance = glm::vec3(4.0f);
     fs.lights = {sun, point};
-    if (env) fs.environment = &shared_env(false);
+    if (env) fs.environment = &white_or_sky_env(false);
     Framebuffer fb(48, 40);
     sr.render(fs, fb);
     return fb.color;
@@ -511,7 +451,7 @@ TEST_CASE("white furnace: coat, specular colour and weight at their extremes sta
 }
 
 TEST_CASE("white furnace under a uniform sky: split sum and reference with the coat and the specular extension") {
-    const Environment& env = shared_env(true);
+    const Environment& env = white_or_sky_env(true);
     const glm::vec3 n(0.0f, 1.0f, 0.0f);
     for (BrdfModel model : {BrdfModel::Default, BrdfModel::Gltf}) {
         double max_energy = 0, max_plain = 0, worst_ref = 0, min_energy = 9;
@@ -522,7 +462,7 @@ TEST_CASE("white furnace under a uniform sky: split sum and reference with the c
                         const glm::vec3 v = view_about(n, cos_v, 0.3);
                         CAPTURE(std::string(brdf_model_name(model))); CAPTURE(metallic); CAPTURE(coat_r); CAPTURE(r); CAPTURE(cos_v);
                         for (bool energy : {false, true}) {
-                            Point p = make_point(env, n, v, glm::vec3(1.0f), metallic, r, energy, model);
+                            IblPoint p = make_ibl_point(env, n, v, glm::vec3(1.0f), metallic, r, energy, model);
                             p.ms.clearcoat = 1.0f;
                             p.ms.clearcoat_roughness = coat_r;
                             p.ms.has_specular = true;
@@ -559,7 +499,7 @@ TEST_CASE("split sum against the reference integral: the coat and the specular c
     // test_ibl.cpp measures the base lobe, albedo (0.9, 0.6, 0.4), metallic
     // 0, base roughness 0.5, four normals, n.v 0.95 .. 0.15. The reference
     // takes 8192 directions. Bounds: measured plus a margin.
-    const Environment& env = shared_env(false);
+    const Environment& env = white_or_sky_env(false);
     const glm::vec3 normals[] = {{0, 1, 0}, glm::normalize(glm::vec3(0.6f, 0.5f, -0.6f)), {1, 0, 0},
                                  glm::normalize(glm::vec3(-0.3f, -0.2f, 0.9f))};
     struct Case { const char* label; float coat, coat_r; bool spec; double mean, max_near, max_all; float sheen_r = -1.0f; };
@@ -578,7 +518,7 @@ TEST_CASE("split sum against the reference integral: the coat and the specular c
         for (double cos_v : {0.95, 0.7, 0.4, 0.15}) {
             for (const glm::vec3& n : normals) {
                 const glm::vec3 v = view_about(n, cos_v, 0.7);
-                Point p = make_point(env, n, v, glm::vec3(0.9f, 0.6f, 0.4f), 0.0f, 0.5f, false, BrdfModel::Default);
+                IblPoint p = make_ibl_point(env, n, v, glm::vec3(0.9f, 0.6f, 0.4f), 0.0f, 0.5f, false, BrdfModel::Default);
                 p.ms.clearcoat = c.coat;
                 p.ms.clearcoat_roughness = c.coat_r;
                 if (c.sheen_r >= 0.0f) {
@@ -788,27 +728,9 @@ TEST_CASE("step: the breakdown shows the coat and specular terms, its srgb8 equa
         std::vector<std::string> flags = {file, "--eye", "0.3,0.4,3", "--target", "0,0,0", "--size", "40x32",
                                           "--msaa", "1", "--sun", "0.3,0.5,1:2,2,2"};
         flags.insert(flags.end(), extra.begin(), extra.end());
-        std::vector<std::string> png_args = flags;
-        png_args.insert(png_args.end(), {"-o", "r.png"});
-        const CliRun rr = box.run_exe(PRAST_RENDER_EXE, png_args);
-        INFO(rr.err);
-        REQUIRE(rr.code == 0);
-        const Rgb8 png = load_rgb8(box.path("r.png"));
-        REQUIRE(!png.empty());
-        // step reads its commands from standard input.
-        std::string commands;
-        std::vector<std::pair<int, int>> pixels;
-        for (int y = 4; y < 32; y += 6)
-            for (int x = 4; x < 40; x += 6) {
-                pixels.push_back({x, y});
-                commands += "pixel " + std::to_string(x) + " " + std::to_string(y) + "\n";
-            }
-        commands += "verify\n";
-        const CliRun sr = box.run_exe_with_input(PRAST_STEP_EXE, flags, commands);
-        const std::string& out = sr.out;
-        INFO(out.substr(0, 4000) << sr.err);
-        REQUIRE(sr.code == 0);
-        CHECK(out.find("verify: ok, all identical") != std::string::npos);
+        const StepAgainstRender r = step_pixels_match_render(box, flags, 4, 6);
+        const std::string& out = r.step.out;
+        INFO(out.substr(0, 4000));
         CHECK(out.find("KHR_materials_specular: specular 0.7") != std::string::npos);
         CHECK(out.find("KHR_materials_clearcoat: clearcoat 0.9") != std::string::npos);
         CHECK(out.find("(its own normal map, scale 1)") != std::string::npos);
@@ -816,25 +738,7 @@ TEST_CASE("step: the breakdown shows the coat and specular terms, its srgb8 equa
         CHECK(out.find("map specularColorTexture") != std::string::npos);
         CHECK(out.find("KHR_materials_sheen: colour ") != std::string::npos);
         CHECK(out.find(extra.empty() ? "    sheen: D " : "    sheen: irradiance ") != std::string::npos);
-        // Each pixel's srgb8 line equals the PNG.
-        std::size_t at = 0;
-        int seen = 0, covered = 0;
-        for (const auto& [x, y] : pixels) {
-            at = out.find("srgb8 ", at);
-            REQUIRE(at != std::string::npos);
-            int c[3] = {-1, -1, -1};
-            std::sscanf(out.c_str() + at, "srgb8 %d %d %d", &c[0], &c[1], &c[2]);
-            ++at;
-            const std::uint8_t* p = png.at(x, y);
-            CAPTURE(x); CAPTURE(y);
-            CHECK(c[0] == int(p[0]));
-            CHECK(c[1] == int(p[1]));
-            CHECK(c[2] == int(p[2]));
-            covered += p[0] + p[1] + p[2] > 0;
-            ++seen;
-        }
-        CHECK(seen == int(pixels.size()));
-        CHECK(covered > 10);
+        CHECK(r.lit > 10);
     }
 }
 

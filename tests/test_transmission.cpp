@@ -29,55 +29,19 @@
 #include "shading/surface.h"
 #include "tests/cli_util.h"
 #include "tests/gltf_writer.h"
+#include "tests/ibl_test_util.h"
 #include "tests/scratch.h"
+#include "tests/step_check.h"
 #include "tests/shading_test_util.h"
 
 using namespace prast;
 using prast::gltf_test::GltfWriter;
 using json = nlohmann::json;
+using namespace prast::test;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-ThreadPool& pool2() {
-    static ThreadPool p(2);
-    return p;
-}
-
-Image make_env(int w, glm::vec3 (*fn)(const glm::dvec3&)) {
-    Image img;
-    img.width = w;
-    img.height = w / 2;
-    img.rgba.assign(std::size_t(img.width) * img.height * 4, 1.0f);
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x)
-            img.set(x, y, glm::vec4(fn(equirect_direction((x + 0.5) / img.width, (y + 0.5) / img.height)), 1.0f));
-    return img;
-}
-
-glm::vec3 white(const glm::dvec3&) { return glm::vec3(1.0f); }
-// A sky with structure (test_material_lobes.cpp's): gradient, soft sun, warm ground.
-glm::vec3 sky(const glm::dvec3& d) {
-    const glm::dvec3 sun = glm::normalize(glm::dvec3(0.5, 0.5, -0.6));
-    const double up = std::max(d.y, 0.0);
-    glm::dvec3 c = d.y > 0.0 ? glm::mix(glm::dvec3(0.8, 0.85, 0.9), glm::dvec3(0.15, 0.3, 0.7), std::sqrt(up))
-                             : glm::dvec3(0.3, 0.22, 0.15) * (1.0 + 0.5 * d.y);
-    const double a = std::acos(std::clamp(glm::dot(d, sun), -1.0, 1.0));
-    c += glm::dvec3(20.0, 18.0, 15.0) * std::exp(-a * a / (2.0 * 0.05 * 0.05));
-    return glm::vec3(c);
-}
-
-const Environment& shared_env(bool uniform) {
-    static const Environment u = Environment::build(make_env(64, white), {1.0f, 0.0f, true}, pool2());
-    static const Environment s = Environment::build(make_env(256, sky), {1.0f, 0.0f, true}, pool2());
-    return uniform ? u : s;
-}
-const DfgTable& shared_dfg(BrdfModel m) {
-    static const DfgTable ibl = DfgTable::build(DfgModel::SchlickIbl, pool2());
-    static const DfgTable correlated = DfgTable::build(DfgModel::HeightCorrelated, pool2());
-    return m == BrdfModel::Gltf ? correlated : ibl;
-}
 
 struct Point {
     MaterialSample ms;
@@ -95,7 +59,7 @@ Point make_point(const Environment* env, const glm::vec3& n, const glm::vec3& v,
     p.ctx.eye = v * 5.0f;
     p.ctx.model = model;
     p.ctx.env = env;
-    p.ctx.dfg_ibl = env ? &shared_dfg(model) : nullptr;
+    p.ctx.dfg_ibl = env ? &dfg_for(model) : nullptr;
     return p;
 }
 
@@ -114,8 +78,6 @@ bool close(const glm::vec3& a, const glm::vec3& b, float rel) {
 }
 
 // ---- Files
-
-
 
 json glass(const json& ext = json()) {
     json m = {{"pbrMetallicRoughness", {{"baseColorFactor", {0.9, 0.7, 0.5, 1}}, {"metallicFactor", 0.0},
@@ -180,14 +142,14 @@ TEST_CASE("transmission 0 (and a volume without transmission) is the same bits a
     CHECK_FALSE(zero.materials[0].has_transmission);
     CHECK_FALSE(zero.materials[0].layered());
     CHECK(zero.materials[0].has_volume);
-    for (const Environment* env : {static_cast<const Environment*>(nullptr), &shared_env(false)}) {
+    for (const Environment* env : {static_cast<const Environment*>(nullptr), &white_or_sky_env(false)}) {
         const std::vector<float> a = draw(plain, env);
         CHECK(a == draw(zero, env));
         CHECK(a == draw(empty, env));
         CHECK(a == draw(volume_only, env));
     }
     // And the scalar functions: the inputs of transmission 0 change nothing.
-    Point p = make_point(&shared_env(false), {0, 1, 0}, view_about({0, 1, 0}, 0.6, 0.2), {0.9f, 0.6f, 0.4f}, 0.4f,
+    Point p = make_point(&white_or_sky_env(false), {0, 1, 0}, view_about({0, 1, 0}, 0.6, 0.2), {0.9f, 0.6f, 0.4f}, 0.4f,
                          BrdfModel::Default);
     const glm::vec3 before = shade_surface(p.ms, p.sp, p.ctx);
     p.ms.thickness = 3.0f;
@@ -205,7 +167,7 @@ TEST_CASE("transmission 1, roughness 0, uniform sky: the sky times (F0 A + B) + 
     // sum's specular albedo at (n.v, 0.045)) but for the lobe's single-
     // scattering loss 1 - (A + B), below 2e-3 here. Tolerance 1e-4 relative
     // for the prefiltered constant map's float rounding.
-    const Environment& env = shared_env(true);
+    const Environment& env = white_or_sky_env(true);
     const glm::vec3 n(0.0f, 1.0f, 0.0f), albedo(0.9f, 0.5f, 0.2f);
     int checked = 0;
     for (BrdfModel model : {BrdfModel::Default, BrdfModel::Gltf}) {
@@ -216,7 +178,7 @@ TEST_CASE("transmission 1, roughness 0, uniform sky: the sky times (F0 A + B) + 
                 p.ms.transmission = 1.0f;
                 p.ms.thickness = thickness;
                 const IblTerms t = ibl_terms(p.ms, p.sp, p.ctx);
-                const glm::vec4 dfg = shared_dfg(model).lookup(t.NoV, kMinPerceptualRoughness);
+                const glm::vec4 dfg = dfg_for(model).lookup(t.NoV, kMinPerceptualRoughness);
                 const float E = 0.04f * dfg.x + dfg.y, loss = 1.0f - (dfg.x + dfg.y);
                 CHECK(t.transmission);
                 CHECK(t.diffuse == glm::vec3(0.0f));
@@ -252,7 +214,7 @@ TEST_CASE("volume: Beer-Lambert transmittance colour^(thickness / distance) per 
     CHECK(volume_transmittance(2.0f, 0.0f, c) == glm::vec3(1.0f));   // infinite distance
     CHECK(volume_transmittance(2.0f, 1.0f, glm::vec3(0.0f, 1.0f, 0.5f)) == glm::vec3(0.0f, 1.0f, 0.25f));
     // Under the uniform sky the transmitted term carries it exactly.
-    const Environment& env = shared_env(true);
+    const Environment& env = white_or_sky_env(true);
     const glm::vec3 n(0.0f, 1.0f, 0.0f), albedo(1.0f);
     Point p = make_point(&env, n, view_about(n, 0.8, 0.1), albedo, 0.0f, BrdfModel::Gltf);
     p.ms.transmission = 1.0f;
@@ -314,7 +276,7 @@ TEST_CASE("the reference integral covers transmission: a white furnace and the s
     // and with --energy conserve (F0 A + B) comp + (1 - E_spec) = 1; the
     // reference integral of the same lobes (measured: within 0.004 of each)
     // stays within 0.01.
-    const Environment& uniform = shared_env(true);
+    const Environment& uniform = white_or_sky_env(true);
     const glm::vec3 n(0.0f, 1.0f, 0.0f);
     double worst_furnace = 0, worst_energy = 0, worst_eref = 0;
     for (BrdfModel model : {BrdfModel::Default, BrdfModel::Gltf})
@@ -346,7 +308,7 @@ TEST_CASE("the reference integral covers transmission: a white furnace and the s
     // rough cases are the coarsest: one prefiltered lookup stands for a lobe
     // that the mirror makes as lopsided as the reflection's at grazing, and
     // for a volume the whole lobe is turned by the exit direction's turn.
-    const Environment& env = shared_env(false);
+    const Environment& env = white_or_sky_env(false);
     const glm::vec3 normals[] = {{0, 1, 0}, glm::normalize(glm::vec3(0.6f, 0.5f, -0.6f)), {1, 0, 0},
                                  glm::normalize(glm::vec3(-0.3f, -0.2f, 0.9f))};
     struct Case { const char* label; float r, thickness; double mean, max_near, max_all; };
@@ -451,10 +413,10 @@ TEST_CASE("hostile factors: one warning each, clamped or defaulted, drawn finite
     CHECK(s.materials[1].attenuation_color == glm::vec3(1.0f));
     CHECK_FALSE(s.materials[2].has_transmission);
     CHECK(s.materials[2].thickness_factor == 3.0e38f);
-    const std::vector<float> one = draw(s, &shared_env(false));
+    const std::vector<float> one = draw(s, &white_or_sky_env(false));
     for (float x : one) REQUIRE(std::isfinite(x));
     for (float x : draw(s, nullptr)) REQUIRE(std::isfinite(x));
-    CHECK(one == draw(s, &shared_env(false), 2));  // the same bits on 2 threads
+    CHECK(one == draw(s, &white_or_sky_env(false), 2));  // the same bits on 2 threads
 }
 
 TEST_CASE("step: the breakdown shows the transmission terms, its srgb8 equals render's PNG, and verify passes") {
@@ -476,46 +438,15 @@ TEST_CASE("step: the breakdown shows the transmission terms, its srgb8 equals re
         std::vector<std::string> flags = {file, "--eye", "0.3,0.4,3", "--target", "0,0,0", "--size", "40x32",
                                           "--msaa", "1", "--sun", "0.3,0.5,1:2,2,2", "--sun", "-0.2,0.1,-1:3,3,3"};
         flags.insert(flags.end(), extra.begin(), extra.end());
-        std::vector<std::string> png_args = flags;
-        png_args.insert(png_args.end(), {"-o", "r.png"});
-        const CliRun rr = box.run_exe(PRAST_RENDER_EXE, png_args);
-        INFO(rr.err);
-        REQUIRE(rr.code == 0);
-        CHECK(rr.err.empty());
-        const Rgb8 png = load_rgb8(box.path("r.png"));
-        REQUIRE(!png.empty());
-        std::string commands;
-        std::vector<std::pair<int, int>> pixels;
-        for (int y = 4; y < 32; y += 6)
-            for (int x = 4; x < 40; x += 6) {
-                pixels.push_back({x, y});
-                commands += "pixel " + std::to_string(x) + " " + std::to_string(y) + "\n";
-            }
-        commands += "verify\n";
-        const CliRun sr = box.run_exe_with_input(PRAST_STEP_EXE, flags, commands);
-        const std::string& out = sr.out;
-        INFO(out.substr(0, 4000) << sr.err);
-        REQUIRE(sr.code == 0);
-        CHECK(out.find("verify: ok, all identical") != std::string::npos);
+        const StepAgainstRender r = step_pixels_match_render(box, flags, 4, 6);
+        CHECK(r.render.err.empty());
+        const std::string& out = r.step.out;
+        INFO(out.substr(0, 4000));
         CHECK(out.find("KHR_materials_transmission: transmission 0.8") != std::string::npos);
         CHECK(out.find("KHR_materials_volume: thickness 0.5") != std::string::npos);
         CHECK(out.find(extra.empty() ? "    transmission: the light is behind" : "    transmission: prefiltered ") !=
               std::string::npos);
-        std::size_t at = 0;
-        int covered = 0;
-        for (const auto& [x, y] : pixels) {
-            at = out.find("srgb8 ", at);
-            REQUIRE(at != std::string::npos);
-            int c[3] = {-1, -1, -1};
-            std::sscanf(out.c_str() + at, "srgb8 %d %d %d", &c[0], &c[1], &c[2]);
-            ++at;
-            const std::uint8_t* p = png.at(x, y);
-            CHECK(c[0] == p[0]);
-            CHECK(c[1] == p[1]);
-            CHECK(c[2] == p[2]);
-            covered += p[0] + p[1] + p[2] > 0;
-        }
-        CHECK(covered > 10);
+        CHECK(r.lit > 10);
     }
     // --ibl reference draws it, finite.
     const CliRun ref = box.run_exe(PRAST_RENDER_EXE, {file, "--env", env, "--ibl", "reference", "--samples", "64", "--size",
