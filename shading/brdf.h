@@ -447,6 +447,18 @@ inline glm::vec3 brdf_fresnel(const BrdfInputs& in, float VoH) {
     return F_Schlick(glm::mix(glm::vec3(f0_from_ior(in.ior)), in.albedo, in.metallic), VoH);
 }
 
+// The scalar part D G / (4 n.v n.l) of a GGX lobe with perceptual roughness
+// r (alpha a = r^2) and distribution value D; with the glTF BRDF D V. The
+// clear coat's and the transmission's lobes; G gets G (or V).
+inline float ggx_lobe(BrdfModel model, bool ibl_geometry, float NoV, float NoL, float D, float r, float a, float& G) {
+    if (model == BrdfModel::Gltf) {
+        G = V_SmithGGXCorrelated(NoV, NoL, a);
+        return D * G;
+    }
+    G = G_Smith(NoV, NoL, ibl_geometry ? k_ibl(r) : k_direct(r));
+    return D * G / (4.0f * std::max(NoV, kBrdfMinCos) * std::max(NoL, kBrdfMinCos));
+}
+
 inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
     BrdfTerms t;
     // Compute cosines and h. l = -v has no half vector; any h gives n.l <= 0 there.
@@ -511,14 +523,7 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
             const float at = rt * rt;
             t.tr_F = brdf_fresnel(in, t.tr_VoH);
             t.tr_D = D_GGX(t.tr_NoH, at);
-            float lobe;
-            if (model == BrdfModel::Gltf) {
-                t.tr_G = V_SmithGGXCorrelated(t.NoV, t.tr_NoL, at);
-                lobe = t.tr_D * t.tr_G;
-            } else {
-                t.tr_G = G_Smith(t.NoV, t.tr_NoL, in.ibl_geometry ? k_ibl(rt) : k_direct(rt));
-                lobe = t.tr_D * t.tr_G / (4.0f * std::max(t.NoV, kBrdfMinCos) * std::max(t.tr_NoL, kBrdfMinCos));
-            }
+            const float lobe = ggx_lobe(model, in.ibl_geometry, t.NoV, t.tr_NoL, t.tr_D, rt, at, t.tr_G);
             t.tr_f = (glm::vec3(1.0f) - t.tr_F) * in.albedo * in.transmittance *
                      (in.transmission * (1.0f - metallic) * lobe);
             if (in.energy) t.tr_f = t.tr_f * in.transmission_comp;
@@ -553,15 +558,7 @@ inline BrdfTerms evaluate_brdf(const BrdfInputs& in, BrdfModel model) {
         const float ac = rc * rc;
         t.coat_F = F_Schlick(kClearcoatF0, t.coat_NoV);
         t.coat_D = D_GGX(t.coat_NoH, ac);
-        float lobe;
-        if (model == BrdfModel::Gltf) {
-            t.coat_G = V_SmithGGXCorrelated(t.coat_NoV, t.coat_NoL, ac);
-            lobe = t.coat_D * t.coat_G;
-        } else {
-            t.coat_G = G_Smith(t.coat_NoV, t.coat_NoL, in.ibl_geometry ? k_ibl(rc) : k_direct(rc));
-            lobe = t.coat_D * t.coat_G /
-                   (4.0f * std::max(t.coat_NoV, kBrdfMinCos) * std::max(t.coat_NoL, kBrdfMinCos));
-        }
+        const float lobe = ggx_lobe(model, in.ibl_geometry, t.coat_NoV, t.coat_NoL, t.coat_D, rc, ac, t.coat_G);
         t.coat_attenuation = 1.0f - in.clearcoat * t.coat_F;
         t.coat_specular = in.clearcoat * t.coat_F * lobe;
         t.diffuse = t.diffuse * t.coat_attenuation;

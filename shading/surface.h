@@ -351,6 +351,33 @@ inline glm::vec3 map_normal(const glm::vec3& N, const glm::vec4& tangent, const 
     return safe_normalize(T * nt.x + B * nt.y + N * nt.z, N);
 }
 
+// The split sum's look-ups for a GGX lobe about n of clamped perceptual
+// roughness r, seen from v (d = n.v, NoV its clamped value): the lobe's
+// dominant direction, the mirror direction bent towards n as the surface
+// roughens, mix(R, n, alpha^2) as Filament does (after Lagarde & de Rousiers
+// 2014; against the reference it halves the split sum's error on rough
+// metals, and at r = 0.045 the bend is 4e-6, so a mirror still returns the
+// environment; Frostbite's lerp factor (1 - alpha)(sqrt(1 - alpha) + alpha)
+// measured 15% better on rough metals but bends a mirror by alpha / 2); the
+// prefiltered radiance along it and its level; the DFG terms at (NoV, r).
+struct LobeLookup {
+    glm::vec3 R, prefiltered;
+    float level;
+    glm::vec4 dfg;
+};
+inline LobeLookup lobe_lookup(const Environment& env, const DfgTable& dfg, const glm::vec3& n, const glm::vec3& v,
+                              float d, float NoV, float r) {
+    LobeLookup o;
+    const glm::vec3 R = n * (2.0f * d) - v;
+    const float f = (r * r) * (r * r);
+    o.R = R * (1.0f - f) + n * f;
+    o.level = Environment::roughness_lod(r);
+    o.prefiltered = env.prefiltered(o.R, o.level);
+    o.level = glm::clamp(o.level, 0.0f, float(Environment::kSpecularLevels - 1));
+    o.dfg = dfg.lookup(NoV, r);
+    return o;
+}
+
 } // namespace surface_detail
 
 // The least n.v the shading reads (docs/shading.md, "Normals that face
@@ -636,20 +663,11 @@ inline IblTerms ibl_terms(const MaterialSample& ms, const SurfacePoint& sp, cons
     const float d = glm::dot(n, v);
     t.NoV = glm::clamp(d, kMinNoV, 1.0f);
     const float r = glm::clamp(ms.roughness, kMinPerceptualRoughness, 1.0f);
-    // The lobe's dominant direction: the mirror direction bent towards n as
-    // the surface roughens, mix(R, n, alpha^2) as Filament does (after
-    // Lagarde & de Rousiers 2014). Against the reference it halves the split
-    // sum's error on rough metals; at r = 0.045 the bend is 4e-6, so a mirror
-    // still returns the environment. (Frostbite's lerp factor
-    // (1 - alpha)(sqrt(1 - alpha) + alpha) measured 15% better on rough
-    // metals but bends a mirror by alpha / 2.)
-    const glm::vec3 R = n * (2.0f * d) - v;
-    const float f = (r * r) * (r * r);
-    t.R = R * (1.0f - f) + n * f;
-    t.level = Environment::roughness_lod(r);
-    t.prefiltered = env.prefiltered(t.R, t.level);
-    t.level = glm::clamp(t.level, 0.0f, float(Environment::kSpecularLevels - 1));
-    const glm::vec4 dfg = ctx.dfg_ibl->lookup(t.NoV, r);
+    const surface_detail::LobeLookup lobe = surface_detail::lobe_lookup(env, *ctx.dfg_ibl, n, v, d, t.NoV, r);
+    t.R = lobe.R;
+    t.level = lobe.level;
+    t.prefiltered = lobe.prefiltered;
+    const glm::vec4 dfg = lobe.dfg;
     t.dfg_scale = dfg.x;
     t.dfg_bias = dfg.y;
     t.dfg_diffuse = dfg.z;
@@ -746,13 +764,11 @@ inline IblTerms ibl_terms(const MaterialSample& ms, const SurfacePoint& sp, cons
         const float dc = glm::dot(nc, v);
         t.coat_NoV = glm::clamp(dc, kMinNoV, 1.0f);
         const float rc = glm::clamp(ms.clearcoat_roughness, kMinPerceptualRoughness, 1.0f);
-        const glm::vec3 Rc = nc * (2.0f * dc) - v;
-        const float fc = (rc * rc) * (rc * rc);
-        t.coat_R = Rc * (1.0f - fc) + nc * fc;
-        t.coat_level = Environment::roughness_lod(rc);
-        t.coat_prefiltered = env.prefiltered(t.coat_R, t.coat_level);
-        t.coat_level = glm::clamp(t.coat_level, 0.0f, float(Environment::kSpecularLevels - 1));
-        const glm::vec4 cd = ctx.dfg_ibl->lookup(t.coat_NoV, rc);
+        const surface_detail::LobeLookup coat = surface_detail::lobe_lookup(env, *ctx.dfg_ibl, nc, v, dc, t.coat_NoV, rc);
+        t.coat_R = coat.R;
+        t.coat_level = coat.level;
+        t.coat_prefiltered = coat.prefiltered;
+        const glm::vec4 cd = coat.dfg;
         t.coat_dfg_scale = cd.x;
         t.coat_dfg_bias = cd.y;
         t.coat_F = F_Schlick(kClearcoatF0, glm::clamp(dc, 0.0f, 1.0f));

@@ -60,40 +60,27 @@ glm::vec3 integrate_environment(const Environment& env, const BrdfInputs& in_, B
         return l * turn_cos + glm::cross(turn_axis, l) * turn_sin + turn_axis * (glm::dot(turn_axis, l) * (1.0 - turn_cos));
     };
 
+    // count samples' density at l of GGX half vectors about `normal` with
+    // alpha a: D(n.h) n.h / (4 v.h) each, 0 where the half vector is not
+    // on the normal's and v's side.
+    auto ggx_density = [&](int count, const glm::dvec3& l, const glm::dvec3& normal, double a) {
+        const glm::dvec3 hsum = l + v;
+        const double len = glm::length(hsum);
+        if (!(len > 0.0)) return 0.0;
+        const glm::dvec3 h = hsum / len;
+        const double VoH = glm::dot(v, h), NoH = glm::dot(normal, h);
+        return VoH > 0.0 && NoH > 0.0 ? count * D_GGX_d(NoH, a) * NoH / (4.0 * VoH) : 0.0;
+    };
     // sum_s N_s pdf_s(l) for a direction l.
     auto mixture_pdf = [&](const glm::dvec3& l) {
         double p = 0.0;
         const double NoL = glm::dot(n, l);
         if (n_cos > 0 && NoL > 0.0) p += n_cos * NoL / M_PI;
-        if (n_ggx > 0) {
-            const glm::dvec3 hsum = l + v;
-            const double len = glm::length(hsum);
-            if (len > 0.0) {
-                const glm::dvec3 h = hsum / len;
-                const double VoH = glm::dot(v, h), NoH = glm::dot(n, h);
-                if (VoH > 0.0 && NoH > 0.0) p += n_ggx * D_GGX_d(NoH, alpha) * NoH / (4.0 * VoH);
-            }
-        }
+        if (n_ggx > 0) p += ggx_density(n_ggx, l, n, alpha);
         if (n_env > 0) p += n_env * env.direction_pdf(glm::vec3(l));
-        if (n_tr > 0) {  // the GGX density at l mirrored (its samples may land in front too)
-            const glm::dvec3 lm = l - n * (2.0 * NoL);
-            const glm::dvec3 hsum = lm + v;
-            const double len = glm::length(hsum);
-            if (len > 0.0) {
-                const glm::dvec3 h = hsum / len;
-                const double VoH = glm::dot(v, h), NoH = glm::dot(n, h);
-                if (VoH > 0.0 && NoH > 0.0) p += n_tr * D_GGX_d(NoH, alpha_t) * NoH / (4.0 * VoH);
-            }
-        }
-        if (n_coat > 0) {
-            const glm::dvec3 hsum = l + v;
-            const double len = glm::length(hsum);
-            if (len > 0.0) {
-                const glm::dvec3 h = hsum / len;
-                const double VoH = glm::dot(v, h), NoH = glm::dot(nc, h);
-                if (VoH > 0.0 && NoH > 0.0) p += n_coat * D_GGX_d(NoH, alpha_c) * NoH / (4.0 * VoH);
-            }
-        }
+        // The transmission's: the GGX density at l mirrored (its samples may land in front too).
+        if (n_tr > 0) p += ggx_density(n_tr, l - n * (2.0 * NoL), n, alpha_t);
+        if (n_coat > 0) p += ggx_density(n_coat, l, nc, alpha_c);
         return p;
     };
 
