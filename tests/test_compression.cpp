@@ -28,12 +28,14 @@
 #include "tests/cli_util.h"
 #include "tests/gltf_writer.h"
 #include "tests/scratch.h"
+#include "tests/load_error.h"
 
 #if defined(PRAST_HAVE_MESHOPT_ENCODER)
 #include <meshoptimizer.h>
 #endif
 
 using namespace prast;
+using prast::test::load_error;
 using json = nlohmann::json;
 using prast::gltf_test::base64;
 using prast::test::read_bytes;
@@ -48,15 +50,6 @@ namespace {
 std::vector<unsigned char> as_bytes(const void* p, std::size_t n) {
     const auto* b = static_cast<const unsigned char*>(p);
     return std::vector<unsigned char>(b, b + n);
-}
-
-std::string load_error(const std::string& path) {
-    try {
-        load_scene(path);
-    } catch (const LoadError& e) {
-        return e.what();
-    }
-    return "";
 }
 
 // One bufferView's data and how it is compressed.

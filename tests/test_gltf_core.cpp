@@ -22,8 +22,10 @@
 #include "scene/load_scene.h"
 #include "tests/cli_util.h"
 #include "tests/scratch.h"
+#include "tests/load_error.h"
 
 using namespace prast;
+using prast::test::load_error;
 
 namespace {
 
@@ -108,15 +110,6 @@ std::size_t warnings_with(const Scene& s, const std::string& part) {
 Scene load_text(const test::TempDir& dir, const std::string& name, const std::string& text) {
     test::write_text(dir.file(name), text);
     return load_scene(dir.file(name));
-}
-
-std::string load_error(const std::string& path) {
-    try {
-        load_scene(path);
-    } catch (const LoadError& e) {
-        return e.what();
-    }
-    return "";
 }
 
 // A 2x2 RGBA PNG with the given bytes.

@@ -23,9 +23,11 @@
 
 #include "scene/load_scene.h"
 #include "scene/tangents.h"
+#include "tests/load_error.h"
 
 namespace fs = std::filesystem;
 using namespace prast;
+using prast::test::load_error;
 using prast::test::TempDir;
 using prast::test::read_bytes;
 using prast::test::write_bytes;
@@ -34,10 +36,6 @@ using prast::test::write_text;
 namespace {
 
 // ---- Scratch files
-
-
-
-
 
 // A 2x2 RGB PNG, in memory.
 std::vector<unsigned char> tiny_png() {
@@ -64,16 +62,6 @@ bool any_warning(const Scene& s, const std::string& part) {
     for (const std::string& w : s.warnings)
         if (contains(w, part)) return true;
     return false;
-}
-
-// The LoadError message for path, or "" when it loads.
-std::string load_error(const std::string& path) {
-    try {
-        load_scene(path);
-    } catch (const LoadError& e) {
-        return e.what();
-    }
-    return "";
 }
 
 // A failure must be one line naming the file.

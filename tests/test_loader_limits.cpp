@@ -28,8 +28,10 @@
 #include "scene/load_scene.h"
 #include "scene/messages.h"
 #include "tests/cli_util.h"
+#include "tests/load_error.h"
 
 using namespace prast;
+using prast::test::load_error;
 using namespace prast::cli_test;
 
 namespace {
@@ -201,15 +203,6 @@ std::string triangle_gltf(const std::string& extra, const std::string& material 
   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
                  "min": [-1, -1, 0], "max": [1, 1, 0]}]
 })";
-}
-
-std::string load_error(const std::string& path) {
-    try {
-        load_scene(path);
-    } catch (const LoadError& e) {
-        return e.what();
-    }
-    return "";
 }
 
 } // namespace
