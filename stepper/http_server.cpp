@@ -67,6 +67,16 @@ long int_param(const HttpRequest& req, const char* name, long lo, long hi, const
     return out;
 }
 
+// The texture the request's one 'id' names among the frame's (filled into
+// `all`, which the result points into).
+const TextureInfo& texture_param(const HttpRequest& req, const FrameSetup& s, const Recording& rec, TexturesView& all) {
+    if (!make_textures(s, rec, all).empty()) throw BadRequest{500, "the textures cannot be listed"};
+    if (req.param_count("id") != 1) throw BadRequest{400, "parameter 'id': one texture ID (see /api/textures)"};
+    for (const TextureInfo& t : all.textures)
+        if (t.id == req.param("id")) return t;
+    throw BadRequest{404, "unknown texture ID (see /api/textures)"};
+}
+
 bool equals_lower(const std::string& s, const char* lower) {
     std::size_t i = 0;
     for (; i < s.size() && lower[i]; ++i)
@@ -230,12 +240,7 @@ int serve(Session& session, int port) {
         if (path == "/api/texture" || path == "/api/texture.png") {
             // The ID among the frame's; the level among its levels.
             TexturesView all;
-            if (!make_textures(s, rec, all).empty()) throw BadRequest{500, "the textures cannot be listed"};
-            if (req.param_count("id") != 1) throw BadRequest{400, "parameter 'id': one texture ID (see /api/textures)"};
-            const TextureInfo* info = nullptr;
-            for (const TextureInfo& t : all.textures)
-                if (t.id == req.param("id")) info = &t;
-            if (!info) throw BadRequest{404, "unknown texture ID (see /api/textures)"};
+            const TextureInfo* info = &texture_param(req, s, rec, all);
             long level = 0;
             if (req.param_count("level"))
                 level = int_param(req, "level", 0, info->levels - 1, "mip level",
@@ -256,12 +261,7 @@ int serve(Session& session, int port) {
             // As /api/texture: the ID among the frame's, the level among its
             // levels, then x and y inside that level.
             TexturesView all;
-            if (!make_textures(s, rec, all).empty()) throw BadRequest{500, "the textures cannot be listed"};
-            if (req.param_count("id") != 1) throw BadRequest{400, "parameter 'id': one texture ID (see /api/textures)"};
-            const TextureInfo* info = nullptr;
-            for (const TextureInfo& t : all.textures)
-                if (t.id == req.param("id")) info = &t;
-            if (!info) throw BadRequest{404, "unknown texture ID (see /api/textures)"};
+            const TextureInfo* info = &texture_param(req, s, rec, all);
             const long level = int_param(req, "level", 0, info->levels - 1, "mip level",
                                          "the texture has " + std::to_string(info->levels) + " levels");
             const glm::ivec2 size = info->level_sizes[std::size_t(level)];
