@@ -6,20 +6,26 @@
 // memory check), decodes the textures with prast's own decoders, and
 // shades with a GLSL port of the conventions' Cook-Torrance (shading/brdf.h,
 // surface.h): metal-roughness maps, tangent-space normal maps, occlusion,
-// emissive, suns and point lights, the flat ambient term, exposure and the ACES
-// / neutral / clamp tone maps (the sRGB encoding is the target's), and the
-// KHR_materials_specular, _clearcoat and _sheen lobes with their maps
-// (docs/shading.md, "Against llvmpipe", has the agreement and
+// emissive, suns, point lights and KHR_lights_punctual's spot cone and range
+// window, the flat ambient term, exposure and the ACES / neutral / clamp tone
+// maps (the sRGB encoding is the target's), the KHR_materials_specular,
+// _clearcoat and _sheen lobes with their maps, KHR_materials_transmission and
+// _volume under the lights (the mirrored lobe of a light behind the surface,
+// the Beer-Lambert transmittance), KHR_materials_unlit, and
+// KHR_texture_transform with its texCoord override on every map (TEXCOORD_0
+// and _1) (docs/shading.md, "Against llvmpipe", has the agreement and
 // make_lobe_models.py the test models). Textures are uploaded in
 // their 8-bit form (sRGB formats for colour maps) and glGenerateMipmap builds
 // their chains; sampling is trilinear, as render's.
 //
 // Not ported (the bench workloads do not use them): measured conductors (Pc),
-// alpha MASK, debug views, image-based lighting, shadows, blending,
-// KHR_texture_transform, UV sets other than TEXCOORD_0, vertex colours.
+// alpha MASK, debug views, image-based lighting (so transmission sees only
+// the lights behind the surface, never an environment), shadows, blending,
+// vertex colours, --brdf gltf and --energy conserve.
 //
 // Set up as a GL application would for speed, so that the comparison is fair
-// to llvmpipe: one fragment program per combination of maps, layered lobes and tone map
+// to llvmpipe: one fragment program per combination of maps, their UV sets and
+// transforms, layered lobes and tone map
 // (shader permutations from one source with #defines, not branches on
 // uniforms), vertex and index buffers, 8-bit textures with sRGB formats and
 // generated mips, and an 8-bit sRGB framebuffer object (GL_FRAMEBUFFER_SRGB:
@@ -40,7 +46,9 @@
 #include <GL/glcorearb.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -69,10 +77,11 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 layout(location = 3) in vec4 a_tangent;
+layout(location = 4) in vec2 a_uv1;  // TEXCOORD_1 (disabled, so 0, for meshes without it)
 uniform mat4 u_view_proj;
-out vec3 v_position; out vec3 v_normal; out vec2 v_uv; out vec4 v_tangent;
+out vec3 v_position; out vec3 v_normal; out vec2 v_uv; out vec4 v_tangent; out vec2 v_uv1;
 void main() {
-    v_position = a_position; v_normal = a_normal; v_uv = a_uv; v_tangent = a_tangent;
+    v_position = a_position; v_normal = a_normal; v_uv = a_uv; v_tangent = a_tangent; v_uv1 = a_uv1;
     gl_Position = u_view_proj * vec4(a_position, 1.0);
 }
 )";
@@ -114,16 +123,21 @@ vec3 display(vec3 c) {
 // shading/surface.h (default BRDF), with KHR_materials_specular's F0 / F90,
 // KHR_materials_clearcoat's lobe and KHR_materials_sheen's lobe over the base
 // as evaluate_brdf() has them (in float; brdf.h takes the sheen in double),
-// and the normals bent as facing_normal() bends them. MAPS (bits:
-// 1 base, 2 metal-rough, 4 rough, 8 metal, 16 normal, 32 occlusion, 64
-// emissive, 128 specular, 256 specular colour, 512 clearcoat, 1024 clearcoat
-// roughness, 2048 clearcoat normal, 4096 sheen colour, 8192 sheen roughness;
-// the sheen's albedo table of brdf.h is t_sheen_E), SPECULAR, CLEARCOAT and
-// SHEEN (1: the material has the lobe) and LINEAR_OUT (1: linear radiance for
-// the MSAA resolve) are #defined before it.
+// KHR_materials_transmission's share of the diffuse and its mirrored lobe for
+// a light behind the surface with KHR_materials_volume's transmittance, the
+// spot cone and range window of light_falloff() (surface.h), and the normals
+// bent as facing_normal() bends them. MAPS (bits: 1 base, 2 metal-rough, 4
+// rough, 8 metal, 16 normal, 32 occlusion, 64 emissive, 128 specular, 256
+// specular colour, 512 clearcoat, 1024 clearcoat roughness, 2048 clearcoat
+// normal, 4096 sheen colour, 8192 sheen roughness, 16384 transmission, 32768
+// thickness; the sheen's albedo table of brdf.h is t_sheen_E), XF and SET1
+// (the same bits: the map's UVs go through its KHR_texture_transform, u_xf;
+// the map reads TEXCOORD_1), SPECULAR, CLEARCOAT, SHEEN and TRANSMISSION (1:
+// the material has the lobe), UNLIT (1: KHR_materials_unlit) and LINEAR_OUT
+// (1: linear radiance for the MSAA resolve) are #defined before it.
 const char* kFragmentShader = R"(
 #define HAS(bit) ((MAPS & bit) != 0)
-in vec3 v_position; in vec3 v_normal; in vec2 v_uv; in vec4 v_tangent;
+in vec3 v_position; in vec3 v_normal; in vec2 v_uv; in vec4 v_tangent; in vec2 v_uv1;
 out vec4 o_color;
 uniform vec4 u_base_color_factor;
 uniform float u_metallic_factor, u_roughness_factor, u_normal_scale, u_occlusion_strength, u_ior;
@@ -136,12 +150,28 @@ uniform sampler2D t_specular, t_specular_color, t_clearcoat, t_clearcoat_rough, 
 uniform vec3 u_sheen_color_factor;  // 0: no sheen
 uniform float u_sheen_roughness_factor;
 uniform sampler2D t_sheen_color, t_sheen_rough, t_sheen_E;
+uniform float u_transmission, u_thickness, u_attenuation_distance;  // thickness 0: thin; distance 0: infinite
+uniform vec3 u_attenuation_color;
+uniform sampler2D t_transmission, t_thickness;
+uniform vec4 u_xf[16];          // map i's transform: u' = (x u + y v) + ox, v' = (z u + w v) + oy
+uniform vec2 u_xf_offset[16];
 uniform vec3 u_eye;
 uniform int u_light_count;
 uniform vec4 u_light[8];        // xyz: direction towards the light (w = 0) or position (w = 1)
 uniform vec3 u_light_radiance[8];
+uniform vec4 u_light_shape[8];  // point and spot: cone scale, cone offset, 1 / range^2 (0: none), 1: spot
+uniform vec3 u_light_axis[8];   // spot: towards the light along its axis
 uniform vec3 u_ambient;
 const float PI = 3.14159265358979;
+
+// Map i's UVs: its set, through its transform (i a constant: the branches fold).
+vec2 map_uv(int i) {
+    vec2 uv = ((SET1 >> i) & 1) != 0 ? v_uv1 : v_uv;
+    if (((XF >> i) & 1) != 0)
+        uv = vec2(u_xf[i].x * uv.x + u_xf[i].y * uv.y + u_xf_offset[i].x,
+                  u_xf[i].z * uv.x + u_xf[i].w * uv.y + u_xf_offset[i].y);
+    return uv;
+}
 
 vec3 safe_normalize(vec3 v, vec3 fallback) {
     float len2 = dot(v, v);
@@ -173,39 +203,59 @@ float sheen_E(float NoV, float r) {  // the table's texel centres: n.v i / 31, r
 
 void main() {
     vec4 base = u_base_color_factor;
-    if (HAS(1)) base *= texture(t_base, v_uv);
+    if (HAS(1)) base *= texture(t_base, map_uv(0));
+#if UNLIT
+    // KHR_materials_unlit: the base colour term alone, no light, ambient or emission.
+    o_color = LINEAR_OUT != 0 ? vec4(base.rgb, 1.0) : vec4(display(base.rgb), 1.0);
+    return;
+#endif
     float metallic = u_metallic_factor, roughness = u_roughness_factor;
-    if (HAS(2)) { vec4 mr = texture(t_mr, v_uv); roughness *= mr.g; metallic *= mr.b; }
-    if (HAS(4)) roughness *= texture(t_rough, v_uv).r;
-    if (HAS(8)) metallic *= texture(t_metal, v_uv).r;
+    if (HAS(2)) { vec4 mr = texture(t_mr, map_uv(1)); roughness *= mr.g; metallic *= mr.b; }
+    if (HAS(4)) roughness *= texture(t_rough, map_uv(2)).r;
+    if (HAS(8)) metallic *= texture(t_metal, map_uv(3)).r;
     metallic = clamp(metallic, 0.0, 1.0);
     roughness = clamp(roughness, 0.0, 1.0);
     float occlusion = 1.0;
-    if (HAS(32)) occlusion = 1.0 + u_occlusion_strength * (texture(t_occlusion, v_uv).r - 1.0);
+    if (HAS(32)) occlusion = 1.0 + u_occlusion_strength * (texture(t_occlusion, map_uv(5)).r - 1.0);
     vec3 emissive = u_emissive_factor;
-    if (HAS(64)) emissive *= texture(t_emissive, v_uv).rgb;
+    if (HAS(64)) emissive *= texture(t_emissive, map_uv(6)).rgb;
 #if SPECULAR
     float spec = u_specular_factor;
     vec3 spec_color = u_specular_color_factor;
-    if (HAS(128)) spec *= texture(t_specular, v_uv).a;
-    if (HAS(256)) spec_color *= texture(t_specular_color, v_uv).rgb;
+    if (HAS(128)) spec *= texture(t_specular, map_uv(7)).a;
+    if (HAS(256)) spec_color *= texture(t_specular_color, map_uv(8)).rgb;
     spec = clamp(spec, 0.0, 1.0);
 #endif
 #if CLEARCOAT
     float cc = u_clearcoat, ccr = u_clearcoat_roughness;
-    if (HAS(512)) cc *= texture(t_clearcoat, v_uv).r;
-    if (HAS(1024)) ccr *= texture(t_clearcoat_rough, v_uv).g;
+    if (HAS(512)) cc *= texture(t_clearcoat, map_uv(9)).r;
+    if (HAS(1024)) ccr *= texture(t_clearcoat_rough, map_uv(10)).g;
     cc = clamp(cc, 0.0, 1.0);
     ccr = clamp(ccr, 0.0, 1.0);
 #endif
 #if SHEEN
     vec3 sheen = u_sheen_color_factor;
     float sr = u_sheen_roughness_factor;
-    if (HAS(4096)) sheen *= texture(t_sheen_color, v_uv).rgb;
-    if (HAS(8192)) sr *= texture(t_sheen_rough, v_uv).a;
+    if (HAS(4096)) sheen *= texture(t_sheen_color, map_uv(12)).rgb;
+    if (HAS(8192)) sr *= texture(t_sheen_rough, map_uv(13)).a;
     sheen = clamp(sheen, 0.0, 1.0);
     float rs = clamp(sr, 0.045, 1.0), as = rs * rs;
     float smax = max(sheen.r, max(sheen.g, sheen.b));
+#endif
+#if TRANSMISSION
+    float tr = u_transmission;
+    if (HAS(16384)) tr *= texture(t_transmission, map_uv(14)).r;
+    tr = clamp(tr, 0.0, 1.0);
+    float thickness = u_thickness;
+    if (HAS(32768)) thickness *= texture(t_thickness, map_uv(15)).g;
+    thickness = max(thickness, 0.0);
+    // Beer-Lambert over the thickness: colour^(thickness / distance) per channel.
+    vec3 transmittance = vec3(1.0);
+    if (thickness > 0.0 && u_attenuation_distance > 0.0) {
+        float e = thickness / u_attenuation_distance;
+        for (int c = 0; c < 3; ++c)
+            transmittance[c] = u_attenuation_color[c] > 0.0 ? pow(u_attenuation_color[c], e) : 0.0;
+    }
 #endif
 
     vec3 N = safe_normalize(v_normal, vec3(0.0, 0.0, 1.0));
@@ -218,7 +268,7 @@ void main() {
         if (dot(T, T) > 0.0) {
             float w = v_tangent.w < 0.0 ? -1.0 : 1.0;
             vec3 B = cross(N, T) * w;
-            vec3 nt = texture(t_clearcoat_normal, v_uv).rgb * 2.0 - 1.0;
+            vec3 nt = texture(t_clearcoat_normal, map_uv(11)).rgb * 2.0 - 1.0;
             nt.xy *= u_clearcoat_normal_scale;
             nt = safe_normalize(nt, vec3(0.0, 0.0, 1.0));
             nc = safe_normalize(T * nt.x + B * nt.y + N * nt.z, N) * flip;
@@ -230,7 +280,7 @@ void main() {
         if (dot(T, T) > 0.0) {
             float w = v_tangent.w < 0.0 ? -1.0 : 1.0;
             vec3 B = cross(N, T) * w;
-            vec3 nt = texture(t_normal, v_uv).rgb * 2.0 - 1.0;
+            vec3 nt = texture(t_normal, map_uv(4)).rgb * 2.0 - 1.0;
             nt.xy *= u_normal_scale;
             nt = safe_normalize(nt, vec3(0.0, 0.0, 1.0));
             n = safe_normalize(T * nt.x + B * nt.y + N * nt.z, N) * flip;
@@ -250,6 +300,11 @@ void main() {
 #endif
     float k = (r + 1.0) * (r + 1.0) / 8.0;
     float NoV = clamp(dot(n, v), 0.0, 1.0);
+#if TRANSMISSION
+    // The transmission lobe's roughness: r clamp(2 ior - 2, 0, 1) (applyIorToRoughness).
+    float rt = clamp(roughness * clamp(u_ior * 2.0 - 2.0, 0.0, 1.0), 0.045, 1.0);
+    float at2 = rt * rt * rt * rt, kt = (rt + 1.0) * (rt + 1.0) / 8.0;
+#endif
     vec3 Lo = emissive;
 #if CLEARCOAT
     // The coat: F_coat at n_c.v weights its lobe and attenuates what lies beneath.
@@ -260,6 +315,13 @@ void main() {
     float atten = cc > 0.0 ? 1.0 - cc * Fc : 1.0;
     Lo *= atten;
 #endif
+#if TRANSMISSION
+#if CLEARCOAT
+    float atten_t = atten;  // the coat attenuates the transmitted light as the base
+#else
+    const float atten_t = 1.0;
+#endif
+#endif
     for (int i = 0; i < u_light_count; ++i) {
         vec3 l, radiance;
         if (u_light[i].w == 0.0) { l = u_light[i].xyz; radiance = u_light_radiance[i]; }
@@ -269,6 +331,21 @@ void main() {
             if (!(d2 > 1e-12)) continue;
             l = d / sqrt(d2);
             radiance = u_light_radiance[i] / d2;
+            vec4 shape = u_light_shape[i];
+            if (shape.z > 0.0 || shape.w != 0.0) {
+                // The range window clamp(1 - (d^2 / range^2)^2, 0, 1), then the cone's a^2,
+                // a = clamp(cos(axis, l) scale + offset, 0, 1).
+                float att = 1.0;
+                if (shape.z > 0.0) {
+                    float q = d2 * shape.z;
+                    att = clamp(1.0 - q * q, 0.0, 1.0);
+                }
+                if (shape.w != 0.0) {
+                    float a = clamp(dot(l, u_light_axis[i]) * shape.x + shape.y, 0.0, 1.0);
+                    att = att * (a * a);
+                }
+                radiance *= att;
+            }
         }
         vec3 sum = l + v;
         float len2 = dot(sum, sum);
@@ -282,7 +359,32 @@ void main() {
         float G = (NoV / (NoV * (1.0 - k) + k)) * (NoL / (NoL * (1.0 - k) + k));
         vec3 specular = D * G * F / (4.0 * max(NoV, 1e-4) * max(NoL, 1e-4));
         vec3 kd = (1.0 - F) * (1.0 - metallic);
+#if TRANSMISSION
+        // The transmitted share leaves the diffuse; a light behind the surface
+        // (n.l < 0) comes through the lobe of l mirrored through the surface's
+        // plane, l' = l - 2 (n.l) n, h_t = normalize(l' + v):
+        // (1 - F(v.h_t)) albedo transmittance tr (1 - metallic) D G / (4 n.v n.l'), times n.l'.
+        vec3 f = kd * base.rgb / PI * (1.0 - tr) + specular;
+        vec3 ft = vec3(0.0);
+        float NtL = 0.0;
+        float NoLs = dot(n, l);
+        if (tr > 0.0 && NoLs < 0.0) {
+            vec3 lm = l - n * (2.0 * NoLs);
+            vec3 hs = lm + v;
+            float hl2 = dot(hs, hs);
+            vec3 ht = hl2 > 0.0 ? hs / sqrt(hl2) : n;
+            NtL = clamp(dot(n, lm), 0.0, 1.0);
+            float NtH = clamp(dot(n, ht), 0.0, 1.0), VtH = clamp(dot(v, ht), 0.0, 1.0);
+            vec3 Ft = F0 + (F90 - F0) * pow(1.0 - VtH, 5.0);
+            float dt = NtH * NtH * (at2 - 1.0) + 1.0;
+            float Dt = at2 / (PI * dt * dt);
+            float Gt = (NoV / (NoV * (1.0 - kt) + kt)) * (NtL / (NtL * (1.0 - kt) + kt));
+            ft = (1.0 - Ft) * base.rgb * transmittance *
+                 (tr * (1.0 - metallic) * (Dt * Gt / (4.0 * max(NoV, 1e-4) * max(NtL, 1e-4))));
+        }
+#else
         vec3 f = kd * base.rgb / PI + specular;
+#endif
 #if SHEEN
         if (smax > 0.0) {  // the sheen over the base, which keeps what it leaves
             float Ds = (2.0 + 1.0 / as) * pow(max(1.0 - NoH * NoH, 0.0), 0.5 / as) / (2.0 * PI);
@@ -290,7 +392,13 @@ void main() {
             float Vs = den > 0.0 ? min(1.0 / den, 1.0) : 0.0;
             float scaling = min(1.0 - smax * sheen_E(NoV, rs), 1.0 - smax * sheen_E(NoL, rs));
             f = f * scaling + sheen * (Ds * Vs);
+#if TRANSMISSION
+            ft *= scaling;
+#endif
         }
+#endif
+#if TRANSMISSION
+        Lo += ft * atten_t * radiance * NtL;
 #endif
 #if CLEARCOAT
         Lo += f * atten * radiance * NoL;
@@ -420,10 +528,13 @@ GpuMesh upload(const Mesh& m) {
     g.count = GLsizei(m.indices.size());
     glGenVertexArrays(1, &g.vao);
     glBindVertexArray(g.vao);
-    // Interleaved: position 3, normal 3, uv 2, tangent 4.
-    std::vector<float> v(m.positions.size() * 12, 0.0f);
+    // Interleaved: position 3, normal 3, uv 2, tangent 4, then uv1 2 when the
+    // mesh has TEXCOORD_1 (without, attribute 4 stays disabled and reads 0).
+    const bool uv1 = !m.uvs1.empty();
+    const std::size_t stride = uv1 ? 14 : 12;
+    std::vector<float> v(m.positions.size() * stride, 0.0f);
     for (std::size_t i = 0; i < m.positions.size(); ++i) {
-        float* o = &v[i * 12];
+        float* o = &v[i * stride];
         o[0] = m.positions[i].x; o[1] = m.positions[i].y; o[2] = m.positions[i].z;
         glm::vec3 n = i < m.normals.size() ? m.normals[i] : glm::vec3(0, 0, 1);
         o[3] = n.x; o[4] = n.y; o[5] = n.z;
@@ -431,15 +542,19 @@ GpuMesh upload(const Mesh& m) {
         o[6] = uv.x; o[7] = uv.y;
         glm::vec4 t = i < m.tangents.size() ? m.tangents[i] : glm::vec4(1, 0, 0, 1);
         o[8] = t.x; o[9] = t.y; o[10] = t.z; o[11] = t.w;
+        if (uv1) {
+            glm::vec2 u1 = i < m.uvs1.size() ? m.uvs1[i] : glm::vec2(0.0f);
+            o[12] = u1.x; o[13] = u1.y;
+        }
     }
     GLuint buffers[2];
     glGenBuffers(2, buffers);
     glBindBuffer(GL_ARRAY_BUFFER, buffers[0]);
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(v.size() * sizeof(float)), v.data(), GL_STATIC_DRAW);
-    const int sizes[4] = {3, 3, 2, 4}, offsets[4] = {0, 3, 6, 8};
-    for (int a = 0; a < 4; ++a) {
+    const int sizes[5] = {3, 3, 2, 4, 2}, offsets[5] = {0, 3, 6, 8, 12};
+    for (int a = 0; a < (uv1 ? 5 : 4); ++a) {
         glEnableVertexAttribArray(GLuint(a));
-        glVertexAttribPointer(GLuint(a), sizes[a], GL_FLOAT, GL_FALSE, 12 * sizeof(float),
+        glVertexAttribPointer(GLuint(a), sizes[a], GL_FLOAT, GL_FALSE, GLsizei(stride * sizeof(float)),
                               reinterpret_cast<const void*>(std::size_t(offsets[a]) * sizeof(float)));
     }
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffers[1]);
@@ -474,6 +589,9 @@ int main(int argc, char** argv) {
     if (setup.environment_image)
         std::fprintf(stderr, "llvmpipe-render: warning: image-based lighting is not ported: the environment "
                              "map is not drawn (the lights and the ambient term are)\n");
+    if (opt.brdf != BrdfModel::Default || opt.energy)
+        std::fprintf(stderr, "llvmpipe-render: warning: --brdf gltf and --energy conserve are not ported: the "
+                             "default BRDF is drawn\n");
     const Scene& scene = setup.scene;
     const Camera& camera = setup.settings.camera;
     const std::vector<ShadingLight>& lights = setup.settings.lights;
@@ -507,12 +625,22 @@ int main(int argc, char** argv) {
         }
         return t;
     };
-    constexpr int kUnits = 14;  // the seven core maps, then the specular, clearcoat and sheen ones
-    constexpr int kSpecularBit = 1 << kUnits, kClearcoatBit = 2 << kUnits, kSheenBit = 4 << kUnits;
+    // The seven core maps, then the specular, clearcoat, sheen, transmission
+    // and thickness ones (Material::extension_textures()'s order).
+    constexpr int kUnits = 16;
+    constexpr int kSpecularBit = 1, kClearcoatBit = 2, kSheenBit = 4, kTransmissionBit = 8, kUnlitBit = 16;
+    GLint max_units = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &max_units);
+    if (max_units < kUnits + 1) die("fewer than 17 texture units");
+    // A program: which maps are bound, which of them go through a transform
+    // and which read TEXCOORD_1 (bit per unit), and the lobes.
+    using Permutation = std::array<int, 4>;
     struct GpuMaterial {
         const Material* m;
         GLuint tex[kUnits];
-        int maps = 0;
+        Permutation key{};  // maps, transformed, TEXCOORD_1, lobes
+        // KHR_texture_transform per unit: u' = (xf.x u + xf.y v) + off.x, v' = (xf.z u + xf.w v) + off.y.
+        float xf[kUnits][4], offset[kUnits][2];
     };
     std::vector<GpuMaterial> materials;
     for (const Material& m : scene.materials) {
@@ -522,15 +650,40 @@ int main(int argc, char** argv) {
                           texture(m.specular_texture, false), texture(m.specular_color_texture, true),
                           texture(m.clearcoat_texture, false), texture(m.clearcoat_roughness_texture, false),
                           texture(m.clearcoat_normal_texture, false), texture(m.sheen_color_texture, true),
-                          texture(m.sheen_roughness_texture, false)}};
-        for (int i = 0; i < kUnits; ++i) g.maps |= g.tex[i] ? 1 << i : 0;
-        // The lobes the material has, as program bits above the maps' (render
-        // shades a coat of factor 0 or a black sheen as no coat or sheen).
+                          texture(m.sheen_roughness_texture, false), texture(m.transmission_texture, false),
+                          m.has_volume ? texture(m.thickness_texture, false) : 0u}, {}, {}, {}};
+        // KHR_materials_unlit reads the base colour map alone.
+        if (m.unlit) std::fill(g.tex + 1, g.tex + kUnits, 0u);
+        std::vector<const TextureRef*> refs = {&m.base_color, &m.metallic_roughness, &m.roughness, &m.metallic,
+                                               &m.normal, &m.occlusion, &m.emissive};
+        for (const TextureRef* r : m.extension_textures()) refs.push_back(r);
+        for (int i = 0; i < kUnits; ++i) {
+            g.key[0] |= g.tex[i] ? 1 << i : 0;
+            const TextureRef& r = *refs[std::size_t(i)];
+            g.key[2] |= g.tex[i] && r.texcoord == 1 ? 1 << i : 0;
+            // The extension's T R S: R turns the UVs counter-clockwise in UV
+            // space (u right, v down), so that its example (offset [0, 1],
+            // rotation pi/2, scale 0.5) reads the lower left quadrant.
+            const TextureTransform& t = r.transform;
+            const double c = std::cos(double(t.rotation)), sn = std::sin(double(t.rotation));
+            const float xf[4] = {float(c * double(t.scale.x)), float(sn * double(t.scale.y)),
+                                 float(-sn * double(t.scale.x)), float(c * double(t.scale.y))};
+            std::copy_n(xf, 4, g.xf[i]);
+            g.offset[i][0] = t.offset.x;
+            g.offset[i][1] = t.offset.y;
+            g.key[1] |= g.tex[i] && t.present ? 1 << i : 0;
+        }
+        // The lobes the material has (render shades a coat of factor 0 or a
+        // black sheen as no coat or sheen, an unlit material with none).
         const bool sheen = m.has_sheen && (m.sheen_color_factor.x > 0.0f || m.sheen_color_factor.y > 0.0f ||
                                            m.sheen_color_factor.z > 0.0f);
-        if (m.has_specular) g.maps |= kSpecularBit;
-        if (m.has_clearcoat && m.clearcoat_factor > 0.0f) g.maps |= kClearcoatBit;
-        if (sheen) g.maps |= kSheenBit;
+        if (m.unlit) g.key[3] = kUnlitBit;
+        else {
+            if (m.has_specular) g.key[3] |= kSpecularBit;
+            if (m.has_clearcoat && m.clearcoat_factor > 0.0f) g.key[3] |= kClearcoatBit;
+            if (sheen) g.key[3] |= kSheenBit;
+            if (m.has_transmission) g.key[3] |= kTransmissionBit;
+        }
         materials.push_back(g);
     }
     // The sheen's albedo table (brdf.h), bilinear between its texel centres, on the unit after the maps.
@@ -552,7 +705,7 @@ int main(int argc, char** argv) {
     std::vector<GpuMesh> meshes;
     for (const Mesh& m : scene.meshes) meshes.push_back(upload(m));
 
-    // One program per combination of maps and lobes, with its uniform locations.
+    // One program per permutation, with its uniform locations.
     const int tonemap = opt.effective_tonemap() == ToneMap::Aces ? 1 : opt.effective_tonemap() == ToneMap::Neutral ? 2 : 0;
     const bool msaa = opt.msaa > 1;
     const glm::mat4 vp = camera.view_projection(aspect);
@@ -563,21 +716,29 @@ int main(int argc, char** argv) {
             emissive_factor;
         GLint specular_factor, specular_color_factor, clearcoat, clearcoat_roughness,
             clearcoat_normal_scale, sheen_color_factor, sheen_roughness_factor;
+        GLint transmission, thickness, attenuation_distance, attenuation_color, xf, xf_offset;
     };
-    std::map<int, Program> programs;
-    auto program_for = [&](int maps) -> const Program& {
-        auto it = programs.find(maps);
+    std::map<Permutation, Program> programs;
+    auto program_for = [&](const Permutation& key) -> const Program& {
+        auto it = programs.find(key);
         if (it != programs.end()) return it->second;
-        const std::string defines =
-            "#define MAPS " + std::to_string(maps & (kSpecularBit - 1)) + "\n#define LINEAR_OUT " +
-            (msaa ? "1" : "0") + "\n#define SPECULAR " + (maps & kSpecularBit ? "1" : "0") + "\n#define CLEARCOAT " +
-            (maps & kClearcoatBit ? "1" : "0") + "\n#define SHEEN " + (maps & kSheenBit ? "1" : "0") + "\n";
+        const int lobes = key[3];
+        auto flag = [&](const char* name, int bit) {
+            return std::string("#define ") + name + (lobes & bit ? " 1\n" : " 0\n");
+        };
+        const std::string defines = "#define MAPS " + std::to_string(key[0]) + "\n#define XF " +
+                                    std::to_string(key[1]) + "\n#define SET1 " + std::to_string(key[2]) +
+                                    "\n#define LINEAR_OUT " + (msaa ? "1" : "0") + "\n" +
+                                    flag("SPECULAR", kSpecularBit) + flag("CLEARCOAT", kClearcoatBit) +
+                                    flag("SHEEN", kSheenBit) + flag("TRANSMISSION", kTransmissionBit) +
+                                    flag("UNLIT", kUnlitBit);
         Program p;
         p.id = link_program(kVertexShader, program_source(tonemap, defines, kFragmentShader).c_str());
         glUseProgram(p.id);
         const char* samplers[kUnits] = {"t_base", "t_mr", "t_rough", "t_metal", "t_normal", "t_occlusion",
                                         "t_emissive", "t_specular", "t_specular_color", "t_clearcoat",
-                                        "t_clearcoat_rough", "t_clearcoat_normal", "t_sheen_color", "t_sheen_rough"};
+                                        "t_clearcoat_rough", "t_clearcoat_normal", "t_sheen_color", "t_sheen_rough",
+                                        "t_transmission", "t_thickness"};
         for (int i = 0; i < kUnits; ++i) glUniform1i(loc(p.id, samplers[i]), i);
         glUniform1i(loc(p.id, "t_sheen_E"), kUnits);
         glUniformMatrix4fv(loc(p.id, "u_view_proj"), 1, GL_FALSE, &vp[0][0]);
@@ -590,6 +751,12 @@ int main(int argc, char** argv) {
                         L.point ? 1.0f : 0.0f);
             glUniform3f(loc(p.id, ("u_light_radiance[" + std::to_string(i) + "]").c_str()), L.radiance.x,
                         L.radiance.y, L.radiance.z);
+            // The spot cone (spot_cone()'s scale and offset) and range window of KHR_lights_punctual.
+            const bool spot = L.point && L.spot;
+            glUniform4f(loc(p.id, ("u_light_shape[" + std::to_string(i) + "]").c_str()), L.cone_scale,
+                        L.cone_offset, L.point ? L.range_inv2 : 0.0f, spot ? 1.0f : 0.0f);
+            glUniform3f(loc(p.id, ("u_light_axis[" + std::to_string(i) + "]").c_str()), L.direction.x,
+                        L.direction.y, L.direction.z);
         }
         glUniform3f(loc(p.id, "u_ambient"), opt.ambient.x, opt.ambient.y, opt.ambient.z);
         glUniform1f(loc(p.id, "u_exposure"), opt.exposure);
@@ -607,9 +774,15 @@ int main(int argc, char** argv) {
         p.clearcoat_normal_scale = loc(p.id, "u_clearcoat_normal_scale");
         p.sheen_color_factor = loc(p.id, "u_sheen_color_factor");
         p.sheen_roughness_factor = loc(p.id, "u_sheen_roughness_factor");
-        return programs.emplace(maps, p).first->second;
+        p.transmission = loc(p.id, "u_transmission");
+        p.thickness = loc(p.id, "u_thickness");
+        p.attenuation_distance = loc(p.id, "u_attenuation_distance");
+        p.attenuation_color = loc(p.id, "u_attenuation_color");
+        p.xf = loc(p.id, "u_xf");
+        p.xf_offset = loc(p.id, "u_xf_offset");
+        return programs.emplace(key, p).first->second;
     };
-    for (const GpuMaterial& gm : materials) program_for(gm.maps);
+    for (const GpuMaterial& gm : materials) program_for(gm.key);
 
     // The target: 8-bit sRGB colour (GL_FRAMEBUFFER_SRGB: written values are
     // encoded by the driver) and a 24-bit depth buffer.
@@ -670,7 +843,7 @@ int main(int argc, char** argv) {
         for (const GpuMesh& g : meshes) {
             const GpuMaterial& gm = materials[std::size_t(g.material)];
             const Material& m = *gm.m;
-            const Program& p = program_for(gm.maps);
+            const Program& p = program_for(gm.key);
             glUseProgram(p.id);
             if (m.double_sided) glDisable(GL_CULL_FACE);
             else { glEnable(GL_CULL_FACE); glCullFace(GL_BACK); }
@@ -689,6 +862,14 @@ int main(int argc, char** argv) {
             const glm::vec3 sheen = m.has_sheen ? m.sheen_color_factor : glm::vec3(0.0f);
             glUniform3fv(p.sheen_color_factor, 1, &sheen[0]);
             glUniform1f(p.sheen_roughness_factor, m.sheen_roughness_factor);
+            glUniform1f(p.transmission, m.has_transmission ? m.transmission_factor : 0.0f);
+            glUniform1f(p.thickness, m.has_volume ? m.thickness_factor : 0.0f);
+            glUniform1f(p.attenuation_distance, m.has_volume ? m.attenuation_distance : 0.0f);
+            glUniform3fv(p.attenuation_color, 1, &m.attenuation_color[0]);
+            if (gm.key[1]) {
+                glUniform4fv(p.xf, kUnits, &gm.xf[0][0]);
+                glUniform2fv(p.xf_offset, kUnits, &gm.offset[0][0]);
+            }
             for (int i = 0; i < kUnits; ++i) {
                 glActiveTexture(GLenum(GL_TEXTURE0 + i));
                 glBindTexture(GL_TEXTURE_2D, gm.tex[i]);
