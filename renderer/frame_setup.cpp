@@ -104,7 +104,9 @@ FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameSt
     stage(on_stage, FrameStage::Load);
     const auto t_load = Clock::now();
     Camera camera;
-    if (req.scene.empty()) {
+    if (req.loaded) {
+        out.scene = *req.loaded;
+    } else if (req.scene.empty()) {
         DefaultScene d = make_default_scene();
         out.scene = std::move(d.scene);
         camera = d.camera;
@@ -122,7 +124,8 @@ FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameSt
 
     // The animation and the file camera the flags name, then the pose of
     // frame 0 (the loader gives the rest pose).
-    const std::string scene_name = req.scene.empty() ? std::string("the built-in scene") : req.scene;
+    const bool builtin = req.scene.empty() && !req.loaded;
+    const std::string scene_name = builtin ? std::string("the built-in scene") : req.scene;
     out.animation = kAllAnimations;
     if (!req.animation.empty()) {
         out.animation = find_named(out.scene.animation_names, req.animation);
@@ -151,7 +154,7 @@ FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameSt
     if (out.file_camera >= 0) {
         out.base_camera = scene_camera(out.scene, out.file_camera, out.time, out.aspect(), out.animation);
     } else if (CameraFault f = request_camera(req.camera_request(), out.bounds, out.aspect(),
-                                              req.scene.empty() ? nullptr : &out.scene,
+                                              builtin ? nullptr : &out.scene,
                                               camera, out.base_camera)) {
         return {f.kind == CameraFault::Flag ? kFrameExitUsage : kFrameExitBadFile, f.message};
     }
@@ -171,7 +174,7 @@ FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameSt
     if (req.recording) plan_recording(plan, out.scene, req.width, req.height, req.samples);
     const std::uint64_t budget = memory_budget();
     if (plan.total() > budget)
-        return {kFrameExitBadFile, (req.scene.empty() ? std::string("the built-in scene") : req.scene) +
+        return {kFrameExitBadFile, scene_name +
                                        (req.recording ? ": recording the frame needs " : ": the render needs ") +
                                        plan.describe() + ", more than the " + std::to_string(budget) +
                                        " bytes allowed (half the physical memory)"};
@@ -219,7 +222,7 @@ FrameError start_renderer(FrameSetup& out, const FrameStageHook& on_stage) {
         out.notes.push_back("warning: " + out.renderer->pool().started_fewer() + "; rendering with " +
                             std::to_string(out.renderer->threads()));
     stage(on_stage, FrameStage::DecodeTextures);
-    out.scene_renderer = std::make_unique<SceneRenderer>(out.scene, *out.renderer);
+    out.scene_renderer = std::make_unique<SceneRenderer>(out.scene, *out.renderer, req.decoded.get());
     out.textures_ms = ms_since(t_tex);
     add_warnings(out, out.scene_renderer->warnings());
 

@@ -78,6 +78,11 @@ struct FrameRequest {
     std::string variant;
     double fps = 0.0;
     double orbit_deg = 0.0;                  // a turntable's sweep: the default framing holds over it
+    // A scene loaded (or built) already, drawn instead of loading `scene`,
+    // which then only names it in messages; `decoded` keeps its textures'
+    // decoded images between frames (the Python module's prast.load).
+    std::shared_ptr<const Scene> loaded;
+    std::shared_ptr<DecodedImages> decoded;
 
     CameraRequest camera_request() const {
         return {scene, eye, target, up, fov_deg, near_plane, far_plane, orbit_deg};

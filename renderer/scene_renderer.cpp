@@ -56,7 +56,8 @@ std::vector<ShadingLight> frame_lights(const Scene& scene, const std::vector<Sha
     return lights;
 }
 
-SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(scene), renderer_(renderer) {
+SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer, DecodedImages* kept)
+    : scene_(scene), renderer_(renderer) {
     // Which (image, colour space) pairs the materials need, slot image * 2 + srgb.
     const std::size_t n_images = scene.images.size();
     auto slot_of = [&](const TextureRef& r, bool srgb) -> int {
@@ -123,7 +124,18 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer) : scene_(sc
         const std::size_t slot = std::size_t(slots[std::size_t(task)]);
         const ImageSource& src = scene.images[slot / 2];
         try {
-            images[slot] = src.decoded ? *src.decoded : decode_image(src, slot % 2 == 1);
+            std::shared_ptr<const Image> have;
+            if (kept && !src.decoded) {
+                std::lock_guard<std::mutex> lock(kept->mutex);
+                if (kept->slots.size() > slot) have = kept->slots[slot];
+            }
+            images[slot] = src.decoded ? *src.decoded : have ? *have : decode_image(src, slot % 2 == 1);
+            if (kept && !src.decoded && !have) {
+                auto copy = std::make_shared<const Image>(images[slot]);
+                std::lock_guard<std::mutex> lock(kept->mutex);
+                if (kept->slots.size() <= slot) kept->slots.resize(n_images * 2);
+                kept->slots[slot] = std::move(copy);
+            }
             decoded[slot] = 1;
         } catch (const std::bad_alloc&) {
             errors[slot] = (src.name.empty() ? src.path : src.name) + ": out of memory while decoding";

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -129,11 +130,20 @@ struct NoTaps {
     NullObserver operator()(const SceneDraw&) const { return {}; }
 };
 
+// Decoded images kept between SceneRenderers of one scene (the Python
+// module's loaded scenes): slot image * 2 + srgb, filled on first decode.
+// Decoding is deterministic, so a kept image is the one decoding again gives.
+struct DecodedImages {
+    std::mutex mutex;
+    std::vector<std::shared_ptr<const Image>> slots;
+};
+
 class SceneRenderer {
 public:
-    // Decodes every texture the materials use. A texture that cannot be
-    // decoded is dropped with a warning (the factor alone is used).
-    SceneRenderer(const Scene& scene, Renderer& renderer);
+    // Decodes every texture the materials use (or takes it from `kept`,
+    // adding what it decodes there). A texture that cannot be decoded is
+    // dropped with a warning (the factor alone is used).
+    SceneRenderer(const Scene& scene, Renderer& renderer, DecodedImages* kept = nullptr);
 
     // Renders one frame into fb (resized by the caller): clears to the
     // background (frame_background), draws every mesh, and applies the

@@ -1,7 +1,8 @@
 #!/bin/sh
 # Installs the Debian 12 packages prast builds with (compiler, CMake, the
 # header-only libraries, and zlib, libpng, libwebp and libdraco, linked statically;
-# libmeshoptimizer only for the tests, which encode with it). Runs apt-get through sudo unless already root.
+# libmeshoptimizer only for the tests, which encode with it; pybind11, the
+# Python headers and numpy for the Python module, pytest for its tests). Runs apt-get through sudo unless already root.
 set -e
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
@@ -22,6 +23,10 @@ PACKAGES="
   libdraco-dev
   libwebp-dev
   libmeshoptimizer-dev
+  pybind11-dev
+  python3-dev
+  python3-numpy
+  python3-pytest
 "
 missing=""
 for p in $PACKAGES; do

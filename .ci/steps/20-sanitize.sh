@@ -12,7 +12,7 @@ cd "$(dirname "$0")/../.."
 start=$(date +%s)
 launcher=""
 [ -n "$CMAKE_CXX_COMPILER_LAUNCHER" ] && launcher="-DCMAKE_CXX_COMPILER_LAUNCHER=$CMAKE_CXX_COMPILER_LAUNCHER"
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1 -O1" -DPRAST_SANITIZE=ON $launcher >/dev/null
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1 -O1" -DPRAST_SANITIZE=ON -DPRAST_PYTHON=OFF $launcher >/dev/null
 # Only what the suite runs: the test binary and the executables it drives
 # (the examples are built and tested by the Release run already).
 cmake --build build-asan -j2 --target prast_tests render step prast-diff bench
