@@ -26,6 +26,7 @@
 #include <filesystem>
 #include <map>
 #include <new>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <type_traits>
@@ -1136,7 +1137,9 @@ private:
         return it != texcoords_.end() ? it->second : std::to_string(fallback);
     }
 
-    void read_texcoords() {
+    // The model's JSON parsed again, by nlohmann::json (for what tinygltf
+    // does not keep as the file writes it); null when it cannot be read.
+    nlohmann::json raw_document() const {
         std::uint64_t size = 0;
         const int fd = open_regular_file(path_, "", size);
         struct Closer {
@@ -1155,7 +1158,7 @@ private:
             out.resize(got);
             return out;
         };
-        if (size > scene_detail::kMaxFileBytes) return;
+        if (size > scene_detail::kMaxFileBytes) return nlohmann::json();
         // Of a .glb only its JSON chunk (checked when the model was parsed).
         std::string text = read_at(0, std::size_t(std::min<std::uint64_t>(size, 20)));
         if (text.size() == 20 && text.compare(0, 4, "glTF") == 0)
@@ -1163,8 +1166,11 @@ private:
                                    le32(reinterpret_cast<const unsigned char*>(&text[12])), size - 20)));
         else
             text = read_at(0, std::size_t(size));
-        const nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
-        text = {};
+        return nlohmann::json::parse(text, nullptr, false);
+    }
+
+    void read_texcoords() {
+        const nlohmann::json doc = raw_document();
         const auto materials = doc.is_object() ? doc.find("materials") : doc.end();
         if (!doc.is_object() || materials == doc.end() || !materials->is_array()) return;
         const auto integer = [](const nlohmann::json& v) -> std::string {
@@ -2077,15 +2083,42 @@ private:
                  std::to_string(kMaxVariants) + ", no variants");
             return;
         }
+        // tinygltf drops an empty object ({}) from an array, which would move
+        // every later variant to the index before its own: the file's JSON
+        // read again gives the list as written (tinygltf's when it cannot).
+        std::vector<std::optional<std::string>> names;
+        try {
+            const nlohmann::json doc = raw_document();
+            const nlohmann::json* raw = &doc;
+            for (const char* key : {"extensions", "KHR_materials_variants", "variants"}) {
+                const auto it = raw->is_object() ? raw->find(key) : raw->end();
+                raw = raw->is_object() && it != raw->end() ? &*it : nullptr;
+                if (!raw) break;
+            }
+            if (raw && raw->is_array() && raw->size() <= kMaxVariants)
+                for (const nlohmann::json& v : *raw) {
+                    const auto name = v.is_object() ? v.find("name") : v.end();
+                    names.push_back(v.is_object() && name != v.end() && name->is_string()
+                                        ? std::optional<std::string>(name->get<std::string>())
+                                        : std::nullopt);
+                }
+        } catch (const std::exception&) {
+            names.clear();
+        }
+        if (names.empty())
+            for (std::size_t i = 0; i < list.ArrayLen(); ++i) {
+                const tinygltf::Value& v = list.Get(int(i));
+                const tinygltf::Value& name = v.IsObject() ? v.Get("name") : v;
+                names.push_back(v.IsObject() && name.IsString() ? std::optional<std::string>(name.Get<std::string>())
+                                                                 : std::nullopt);
+            }
         std::set<std::string> seen;
-        for (std::size_t i = 0; i < list.ArrayLen(); ++i) {
-            const tinygltf::Value& v = list.Get(int(i));
-            const tinygltf::Value& name = v.IsObject() ? v.Get("name") : v;
+        for (std::size_t i = 0; i < names.size(); ++i) {
             std::string n = "variant " + std::to_string(i);
-            if (!v.IsObject() || !name.IsString())
+            if (!names[i])
                 warn(what + ": variant " + std::to_string(i) + " has no name string, called '" + n + "'");
             else
-                n = name.Get<std::string>();
+                n = *names[i];
             if (!seen.insert(n).second)
                 warn(what + ": variant " + std::to_string(i) + " repeats the name '" + cut(n) +
                      "' (that name selects the first; the index selects this one)");

@@ -331,6 +331,23 @@ TEST_CASE("hostile variants and mappings: one warning each, the rest kept, never
         CHECK(s.variants == std::vector<std::string>{"x", "variant 1", "variant 2", "x"});
         CHECK(s.meshes[0].variant_materials == std::vector<int>{1, 1, 1, -1});
 
+        // An empty object keeps its index: tinygltf drops {} from arrays,
+        // which moved "late" to index 1 before the loader read the JSON itself.
+        g.doc["extensions"]["KHR_materials_variants"] = {
+            {"variants", json::array({{{"name", "early"}}, json::object(), {{"name", "late"}}})}};
+        g.doc["meshes"][0]["primitives"][0]["extensions"] = mappings({{{"material", 1}, {"variants", {2}}}});
+        s = load(g);
+        CHECK(s.variants == std::vector<std::string>{"early", "variant 1", "late"});
+        CHECK(only(s, "KHR_materials_variants: variant 1 has no name string, called 'variant 1'") == 1);
+        CHECK(s.meshes[0].variant_materials == std::vector<int>{-1, -1, 1});
+        CliSandbox box;
+        const std::string file = write(box, g, "empty.gltf");
+        for (const auto& [variant, out] : {std::pair{"late", "late.png"}, {"2", "two.png"}, {"0", "early.png"}})
+            REQUIRE(box.run_exe(kRender, {file, "--variant", variant, "--size", "16x16", "-o", out}).code == 0);
+        CHECK(read_bytes(box.work() / "late.png") == read_bytes(box.work() / "two.png"));
+        CHECK(read_bytes(box.work() / "late.png") != read_bytes(box.work() / "early.png"));
+
+        g.doc["meshes"][0]["primitives"][0]["extensions"] = mappings({{{"material", 1}, {"variants", {0, 1, 2}}}});
         g.doc["extensions"]["KHR_materials_variants"] = {{"variants", json::object({{"name", "x"}})}};
         s = load(g);
         CHECK(s.variants.empty());
