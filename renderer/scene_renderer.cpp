@@ -1,5 +1,6 @@
 // Texture binding and frame rendering for a Scene; see scene_renderer.h.
 #include "renderer/scene_renderer.h"
+#include "scene/det_math.h"
 #include "renderer/draw_order.h"
 
 #include <algorithm>
@@ -431,7 +432,7 @@ void apply_tile_overlay(Framebuffer& fb, const std::vector<std::uint32_t>& entri
         for (int x = 0; x < fb.width; ++x) {
             std::size_t t = std::size_t(y / tile_size) * tiles_x + x / tile_size;
             float heat = t < entries.size() && entries[t] > 0
-                             ? float(std::log2(1.0 + entries[t]) / std::log2(1.0 + most)) : 0.0f;
+                             ? float(det::log2(1.0 + entries[t]) / det::log2(1.0 + most)) : 0.0f;
             float* c = fb.pixel(x, y);
             glm::vec3 tint = glm::mix(glm::vec3(0.1f, 0.2f, 1.0f), glm::vec3(1.0f, 0.15f, 0.05f), heat);
             bool border = x % tile_size == 0 || y % tile_size == 0;

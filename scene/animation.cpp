@@ -7,6 +7,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "scene/det_math.h"
 #include "scene/load_scene.h"
 #include "scene/tangents.h"
 
@@ -71,12 +72,12 @@ void sample_animation(const AnimationSampler& s, double t, bool rotation, double
                 for (int i = 0; i < 4; ++i) d += double(a[i]) * double(b[i]);
                 const double sign = d < 0.0 ? -1.0 : 1.0;
                 const double cos_a = std::min(std::fabs(d), 1.0);
-                const double angle = std::acos(cos_a);
+                const double angle = det::acos(cos_a);
                 double wa = 1.0 - u, wb = u;
                 if (angle > 1e-9) {
-                    const double sa = std::sin(angle);
-                    wa = std::sin(angle * (1.0 - u)) / sa;
-                    wb = std::sin(angle * u) / sa;
+                    const double sa = det::sin(angle);
+                    wa = det::sin(angle * (1.0 - u)) / sa;
+                    wb = det::sin(angle * u) / sa;
                 }
                 for (int i = 0; i < 4; ++i) out[i] = wa * double(a[i]) + sign * wb * double(b[i]);
             } else {

@@ -6,6 +6,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 glm::mat4 Camera::view() const { return glm::lookAt(eye, target, up); }
@@ -15,8 +17,28 @@ glm::mat4 Camera::projection(float aspect) const {
         const float x = ortho_ymag * aspect;
         return glm::ortho(-x, x, -ortho_ymag, ortho_ymag, near_plane, far_plane);
     }
-    if (infinite_far) return glm::infinitePerspective(glm::radians(fov_y_deg), aspect, near_plane);
-    return glm::perspective(glm::radians(fov_y_deg), aspect, near_plane, far_plane);
+    // glm::perspective's and glm::infinitePerspective's matrices (right-handed,
+    // depth -1 to 1), the same float expressions, with det::tan for the C
+    // library's tanf, which rounds differently on x86-64 and aarch64.
+    const float fovy = glm::radians(fov_y_deg);
+    const float tan_half = det::tan(fovy / 2.0f);
+    glm::mat4 m(0.0f);
+    if (infinite_far) {
+        const float range = tan_half * near_plane;
+        const float left = -range * aspect, right = range * aspect, bottom = -range, top = range;
+        m[0][0] = (2.0f * near_plane) / (right - left);
+        m[1][1] = (2.0f * near_plane) / (top - bottom);
+        m[2][2] = -1.0f;
+        m[2][3] = -1.0f;
+        m[3][2] = -2.0f * near_plane;
+        return m;
+    }
+    m[0][0] = 1.0f / (aspect * tan_half);
+    m[1][1] = 1.0f / tan_half;
+    m[2][2] = -(far_plane + near_plane) / (far_plane - near_plane);
+    m[2][3] = -1.0f;
+    m[3][2] = -(2.0f * far_plane * near_plane) / (far_plane - near_plane);
+    return m;
 }
 
 void fit_clip_planes(Camera& cam, const Bounds& b) {
@@ -34,9 +56,9 @@ Camera frame_bounds(const Bounds& b, float fov_y_deg, float aspect) {
     float r = std::max(b.radius(), 1e-4f);
     // The tighter of the vertical and horizontal half-angles must hold the sphere.
     float half_v = glm::radians(fov_y_deg) * 0.5f;
-    float half_h = std::atan(std::tan(half_v) * aspect);
+    float half_h = det::atan(det::tan(half_v) * aspect);
     float half = std::min(half_v, half_h);
-    float dist = r / std::sin(half) * 1.02f;
+    float dist = r / det::sin(half) * 1.02f;
     glm::vec3 dir = glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f));
     cam.target = b.center();
     cam.eye = cam.target + dir * dist;
@@ -67,7 +89,7 @@ Camera frame_scene(const Scene& scene, float fov_y_deg, float aspect, double orb
     Camera fallback = frame_bounds(bounds, fov_y_deg, aspect);
     if (bounds.empty()) return fallback;
     // In double: the planes below subtract nearly equal depths.
-    const double ky = std::tan(double(glm::radians(fov_y_deg)) * 0.5) * kFrameFill;
+    const double ky = det::tan(double(glm::radians(fov_y_deg)) * 0.5) * kFrameFill;
     const double kx = ky * double(aspect);
     const glm::dvec3 c(bounds.center());
     const glm::dvec3 dir = glm::normalize(glm::dvec3(0.0, 0.35, 1.0));
@@ -127,7 +149,7 @@ Camera frame_scene(const Scene& scene, float fov_y_deg, float aspect, double orb
         constexpr int kOrbitSamples = 72;
         for (int k = 1; k <= kOrbitSamples; ++k) {
             const double t = glm::radians(orbit_deg) * double(k) / double(kOrbitSamples);
-            const double ct = std::cos(t), st = std::sin(t);
+            const double ct = det::cos(t), st = det::sin(t);
             const glm::dvec3 dk(dir.x * ct + dir.z * st, dir.y, -dir.x * st + dir.z * ct);
             const ViewBasis w = view_basis(dk);
             for (const Mesh& m : scene.meshes)

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 namespace {
@@ -68,7 +70,7 @@ CameraFault check_camera(const Camera& cam, const CameraRequest& req, const Boun
 // eye of frame i does not depend on which frames were rendered before it.
 glm::vec3 rotate_around(const glm::vec3& v, const glm::vec3& k, double radians) {
     const glm::dvec3 dv(v), dk(k);
-    const double c = std::cos(radians), s = std::sin(radians);
+    const double c = det::cos(radians), s = det::sin(radians);
     return glm::vec3(dv * c + glm::cross(dk, dv) * s + dk * glm::dot(dk, dv) * (1.0 - c));
 }
 

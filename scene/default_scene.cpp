@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "scene/det_math.h"
 #include "scene/mesh_gen.h"
 #include "scene/procedural_images.h"
 
@@ -40,16 +41,16 @@ Image make_default_sky(int width) {
             // The direction of the texel centre (docs/conventions.md "Environment maps").
             const float phi = ((float(x) + 0.5f) / float(img.width) - 0.5f) * 6.28318531f;
             const float theta = (float(y) + 0.5f) / float(img.height) * 3.14159265f;
-            const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+            const glm::vec3 d(det::sin(theta) * det::sin(phi), det::cos(theta), -det::sin(theta) * det::cos(phi));
             const float up = std::max(d.y, 0.0f);
             glm::vec3 sky = glm::mix(horizon, zenith, std::sqrt(up));
             // The ground darkens towards the nadir; one texel of blend at the horizon.
             const glm::vec3 below = ground * (0.6f + 0.4f * (1.0f + d.y));
             glm::vec3 c = glm::mix(below, sky, smoothstep(-texel, texel, d.y));
             // Sun disc with an anti-aliased rim and a faint glow.
-            const float angle = std::acos(std::clamp(glm::dot(d, kSunDirection), -1.0f, 1.0f));
+            const float angle = det::acos(std::clamp(glm::dot(d, kSunDirection), -1.0f, 1.0f));
             c += sun * (1.0f - smoothstep(sun_radius - texel, sun_radius + texel, angle));
-            c += glm::vec3(1.0f, 0.9f, 0.7f) * (0.6f * std::exp(-angle / 0.12f));
+            c += glm::vec3(1.0f, 0.9f, 0.7f) * (0.6f * det::exp(-angle / 0.12f));
             img.set(x, y, glm::vec4(c, 1.0f));
         }
     return img;

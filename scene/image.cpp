@@ -28,6 +28,7 @@
 #include <webp/decode.h>
 #include <unistd.h>
 
+#include "scene/det_math.h"
 #include "scene/file_access.h"
 #include "scene/hdr_guard.h"
 #include "scene/jpeg_guard.h"
@@ -39,7 +40,7 @@ namespace {
 
 // The sRGB electro-optical transfer function (IEC 61966-2-1), exact form.
 float srgb_to_linear(float c) {
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+    return c <= 0.04045f ? c / 12.92f : det::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
 

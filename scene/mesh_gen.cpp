@@ -5,6 +5,8 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 namespace {
@@ -28,12 +30,12 @@ Mesh make_uv_sphere(glm::vec3 center, float radius, int segments, int rings, int
         float theta = pi * float(i) / float(rings);
         for (int j = 0; j <= segments; ++j) {
             float phi = 2.0f * pi * float(j) / float(segments);
-            glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi));
+            glm::vec3 n(det::sin(theta) * det::cos(phi), det::cos(theta), -det::sin(theta) * det::sin(phi));
             m.positions.push_back(center + radius * n);
             m.normals.push_back(n);
             m.uvs.push_back({float(j) / float(segments), float(i) / float(rings)});
             // dP/dphi; B = cross(N, T) points to the north pole (-v): w = +1.
-            glm::vec3 t(-std::sin(phi), 0.0f, -std::cos(phi));
+            glm::vec3 t(-det::sin(phi), 0.0f, -det::cos(phi));
             m.tangents.push_back(glm::vec4(t, 1.0f));
         }
     }

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 namespace {
@@ -20,7 +22,7 @@ bool finite(const glm::dvec3& v) {
 double corner_angle(const glm::dvec3& a, const glm::dvec3& b) {
     const double la = glm::length(a), lb = glm::length(b);
     if (!(la > 0.0) || !(lb > 0.0)) return 0.0;
-    return std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0, 1.0));
+    return det::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0, 1.0));
 }
 
 // The three corner indices of triangle t, or false when one is out of range.

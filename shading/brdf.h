@@ -17,6 +17,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/constants.hpp>
 
+#include "scene/det_math.h"
 #include "scene/scene.h"
 
 namespace prast {
@@ -160,38 +161,11 @@ inline ConductorIOR conductor_ior(Conductor c) {
 // ---- Sheen (KHR_materials_sheen)
 
 namespace brdf_detail {
-// exp and log from plain double arithmetic (range reduction and fixed
-// series), so the sheen's powers do not depend on which libm variant the
-// CPU selects: relative error < 1e-14 on the ranges the sheen uses.
-inline double det_exp(double x) {
-    if (!(x > -700.0)) return 0.0;  // also NaN
-    if (x > 700.0) x = 700.0;
-    const double k = std::floor(x * 1.4426950408889634 + 0.5);
-    const double r = (x - k * 0.693145751953125) - k * 1.4286068203094173e-06;  // ln 2 in two parts
-    double term = 1.0, sum = 1.0;
-    for (int i = 1; i <= 14; ++i) {
-        term = term * r / double(i);
-        sum += term;
-    }
-    return std::ldexp(sum, int(k));
-}
-// x > 0 and finite.
-inline double det_log(double x) {
-    int e = 0;
-    double m = std::frexp(x, &e);  // m in [0.5, 1)
-    if (m < 0.70710678118654752) {
-        m *= 2.0;
-        --e;
-    }
-    const double t = (m - 1.0) / (m + 1.0), t2 = t * t;  // |t| <= 0.1716
-    double term = t, sum = 0.0;
-    for (int i = 0; i < 12; ++i) {
-        sum += term / double(2 * i + 1);
-        term *= t2;
-    }
-    return 2.0 * sum + double(e) * 0.69314718055994531;
-}
-inline double det_pow(double x, double y) { return x > 0.0 ? det_exp(y * det_log(x)) : 0.0; }
+// exp, log and pow of scene/det_math.h, so the sheen's powers do not depend
+// on which libm variant the CPU selects.
+inline double det_exp(double x) { return det::exp(x); }
+inline double det_log(double x) { return det::log(x); }
+inline double det_pow(double x, double y) { return det::pow(x, y); }
 } // namespace brdf_detail
 
 // The "Charlie" sheen distribution (Conty Estevez and Kulla 2017), alpha =
@@ -246,7 +220,7 @@ inline const std::array<float, kSheenNoV * kSheenRough>& sheen_albedo_table() {
                     double row = 0.0;
                     for (int b = 0; b < kPhi; ++b) {
                         const double phi = (b + 0.5) * pi / kPhi;
-                        const double hx = sl * std::cos(phi) + sv, hy = sl * std::sin(phi), hz = NoL + NoV;
+                        const double hx = sl * det::cos(phi) + sv, hy = sl * det::sin(phi), hz = NoL + NoV;
                         const double NoH = hz / std::sqrt(hx * hx + hy * hy + hz * hz);
                         row += D_Charlie(NoH, alpha);
                     }

@@ -4,16 +4,18 @@
 #include <array>
 #include <cmath>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 float srgb_to_linear(float c) {
     if (c <= 0.04045f) return c / 12.92f;
-    return std::pow((c + 0.055f) / 1.055f, 2.4f);
+    return det::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
 float linear_to_srgb(float x) {
     if (x <= 0.0031308f) return x * 12.92f;
-    return 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+    return 1.055f * det::pow(x, 1.0f / 2.4f) - 0.055f;
 }
 
 std::uint8_t linear_to_srgb8(float x) {

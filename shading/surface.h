@@ -11,6 +11,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/det_math.h"
 #include "shading/brdf.h"
 #include "scene/scene.h"
 #include "shading/ibl/dfg.h"
@@ -31,7 +32,7 @@ struct UvTransform {
     // right, v down): the matrix the extension's examples and sample model
     // use (docs/shading.md). Products in double, rounded once.
     static UvTransform of(const TextureTransform& t) {
-        const double c = std::cos(double(t.rotation)), s = std::sin(double(t.rotation));
+        const double c = det::cos(double(t.rotation)), s = det::sin(double(t.rotation));
         UvTransform x;
         x.m00 = float(c * double(t.scale.x));
         x.m01 = float(s * double(t.scale.y));
@@ -170,7 +171,7 @@ struct ShadingLight {
 // The spot cone's numbers of KHR_lights_punctual's reference code:
 // scale = 1 / max(0.001, cos(inner) - cos(outer)), offset = -cos(outer) scale.
 inline void spot_cone(float inner, float outer, float& scale, float& offset) {
-    const double ci = std::cos(double(inner)), co = std::cos(double(outer));
+    const double ci = det::cos(double(inner)), co = det::cos(double(outer));
     const double sc = 1.0 / std::max(0.001, ci - co);
     scale = float(sc);
     offset = float(-co * sc);

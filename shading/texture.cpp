@@ -12,6 +12,7 @@
 #include <sys/mman.h>
 #endif
 
+#include "scene/det_math.h"
 #include "raster/thread_pool.h"
 
 namespace prast {
@@ -127,7 +128,7 @@ struct SrgbEncoder {
     SrgbEncoder() {
         for (int k = 0; k < 255; ++k) {
             const double c = (double(k) + 0.5) / 255.0;
-            threshold[k] = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+            threshold[k] = c <= 0.04045 ? c / 12.92 : det::pow((c + 0.055) / 1.055, 2.4);
         }
         threshold[255] = HUGE_VAL;
         int b = 0;

@@ -90,7 +90,7 @@ void add_bench_flags(FlagSet& set, BenchOptions& o) {
 
     Flag& s = set.value({"--size"}, "WxH", "scene mode: image size", "1920x1080", {"0x10", "96"},
                         [&o](const std::string& flag, const std::string& v) {
-                            long w, h;
+                            long w = 0, h = 0;
                             if (!parse_size(v, w, h) || w < 1 || h < 1 || w > kMaxViewportSize || h > kMaxViewportSize)
                                 bad_value(flag, v, "expected WxH, each from 1 to " + std::to_string(kMaxViewportSize));
                             o.width = int(w);

@@ -87,7 +87,7 @@ void add_render_flags(FlagSet& set, RenderParse& st, bool render_only) {
         Flag& f = set.value({"--size"}, "WxH", "image size in pixels (default 1280x720)", "1280x720",
                             {"96", "0x0", "100000x100000", "axb"},
                             [&st](const std::string& flag, const std::string& v) {
-                                long w, h;
+                                long w = 0, h = 0;
                                 if (!parse_size(v, w, h)) bad_value(flag, v, "expected WxH, e.g. 1280x720");
                                 const std::string err = check_image_size(w, h, st.memory_budget);
                                 if (!err.empty()) fail(err);

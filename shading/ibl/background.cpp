@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 BackgroundFill::BackgroundFill(const Camera& cam, int width, int height, const Environment* env, Background mode,
@@ -13,7 +15,7 @@ BackgroundFill::BackgroundFill(const Camera& cam, int width, int height, const E
     f_ = glm::normalize(cam.target - cam.eye);
     s_ = glm::normalize(glm::cross(f_, cam.up));
     u_ = glm::cross(s_, f_);
-    half_h_ = std::tan(glm::radians(cam.fov_y_deg) * 0.5f);
+    half_h_ = det::tan(glm::radians(cam.fov_y_deg) * 0.5f);
     half_w_ = half_h_ * float(width) / float(height);
     lod_ = Environment::roughness_lod(kBlurBackgroundRoughness);
     if (env_) level_ = env_->source_level(0);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "scene/det_math.h"
 #include "shading/ibl/prefilter.h"
 
 namespace prast {
@@ -42,8 +43,8 @@ Environment Environment::build(const Image& img, const EnvironmentSettings& s, T
         throw std::invalid_argument("environment: empty image");
     Environment env;
     const double turn = double(s.rotate_deg) * M_PI / 180.0;
-    env.rot_cos_ = s.rotate_deg == 0.0f ? 1.0f : float(std::cos(turn));
-    env.rot_sin_ = s.rotate_deg == 0.0f ? 0.0f : float(std::sin(turn));
+    env.rot_cos_ = s.rotate_deg == 0.0f ? 1.0f : float(det::cos(turn));
+    env.rot_sin_ = s.rotate_deg == 0.0f ? 0.0f : float(det::sin(turn));
 
     // Level sizes: the source (at most kMaxWidth wide), its mips down to 1x1,
     // then the prefiltered levels 1...
@@ -122,7 +123,7 @@ Environment Environment::build(const Image& img, const EnvironmentSettings& s, T
         env.col_cdf_.assign(std::size_t(H) * std::size_t(W + 1), 0.0f);
         std::vector<double> row_weight(std::size_t(H), 0.0);
         pool.run(H, [&](int y, int) {
-            const double omega = 2.0 * M_PI / W * (std::cos(M_PI * y / H) - std::cos(M_PI * (y + 1) / H));
+            const double omega = 2.0 * M_PI / W * (det::cos(M_PI * y / H) - det::cos(M_PI * (y + 1) / H));
             float* cdf = &env.col_cdf_[std::size_t(y) * std::size_t(W + 1)];
             double sum = 0.0;
             std::vector<double> run(std::size_t(W) + 1, 0.0);
@@ -166,13 +167,13 @@ glm::vec3 Environment::sample_direction(glm::dvec2 u, double& pdf) const {
     int x = std::clamp(int(col_it - cdf) - 1, 0, W - 1);
     const double px = double(cdf[x + 1]) - double(cdf[x]);
     const double fx = px > 0.0 ? std::clamp((u.y - double(cdf[x])) / px, 0.0, 1.0) : 0.5;
-    const double c0 = std::cos(M_PI * y / H), c1 = std::cos(M_PI * (y + 1) / H);
+    const double c0 = det::cos(M_PI * y / H), c1 = det::cos(M_PI * (y + 1) / H);
     const double omega = 2.0 * M_PI / W * (c0 - c1);
     pdf = omega > 0.0 ? py * px / omega : 0.0;
     const double cos_theta = c0 + (c1 - c0) * fy;
     const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
     const double phi = ((x + fx) / W - 0.5) * 2.0 * M_PI;
-    const double mx = sin_theta * std::sin(phi), mz = -sin_theta * std::cos(phi);
+    const double mx = sin_theta * det::sin(phi), mz = -sin_theta * det::cos(phi);
     // Map -> world: R_y(angle).
     return glm::vec3(float(mx * rot_cos_ + mz * rot_sin_), float(cos_theta), float(-mx * rot_sin_ + mz * rot_cos_));
 }
@@ -187,7 +188,7 @@ double Environment::direction_pdf(const glm::vec3& dir) const {
     const double py = row_cdf_[std::size_t(y) + 1] - row_cdf_[std::size_t(y)];
     const float* cdf = &col_cdf_[std::size_t(y) * std::size_t(W + 1)];
     const double px = double(cdf[x + 1]) - double(cdf[x]);
-    const double omega = 2.0 * M_PI / W * (std::cos(M_PI * y / H) - std::cos(M_PI * (y + 1) / H));
+    const double omega = 2.0 * M_PI / W * (det::cos(M_PI * y / H) - det::cos(M_PI * (y + 1) / H));
     return omega > 0.0 ? py * px / omega : 0.0;
 }
 

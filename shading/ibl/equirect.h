@@ -18,6 +18,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 namespace equirect_detail {
@@ -58,8 +60,8 @@ namespace equirect_detail {
 // The unit direction at (u, v): the inverse of equirect_uv (precomputation only).
 inline glm::dvec3 equirect_direction(double u, double v) {
     const double phi = (u - 0.5) * 2.0 * M_PI, theta = v * M_PI;
-    const double s = std::sin(theta);
-    return {s * std::sin(phi), std::cos(theta), -s * std::cos(phi)};
+    const double s = det::sin(theta);
+    return {s * det::sin(phi), det::cos(theta), -s * det::cos(phi)};
 }
 
 // One level of an equirectangular map inside a texel array: w x h texels,

@@ -12,6 +12,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 // Van der Corput radical inverse in base 2: the bits of i mirrored about the
@@ -54,7 +56,7 @@ inline glm::dvec3 sample_ggx_half(glm::dvec2 u, double alpha) {
     // (a^2 - 1) written (a - 1)(a + 1) for accuracy near a = 1.
     const double cos2 = (1.0 - u.y) / (1.0 + (alpha - 1.0) * (alpha + 1.0) * u.y);
     const double c = std::sqrt(cos2), s = std::sqrt(std::max(0.0, 1.0 - cos2));
-    return {s * std::cos(phi), s * std::sin(phi), c};
+    return {s * det::cos(phi), s * det::sin(phi), c};
 }
 
 // GGX D in double, for the pdfs of the precomputations.
@@ -68,7 +70,7 @@ inline double D_GGX_d(double NoH, double alpha) {
 inline glm::dvec3 sample_cosine(glm::dvec2 u) {
     const double phi = 2.0 * M_PI * u.x;
     const double s = std::sqrt(u.y), c = std::sqrt(std::max(0.0, 1.0 - u.y));
-    return {s * std::cos(phi), s * std::sin(phi), c};
+    return {s * det::cos(phi), s * det::sin(phi), c};
 }
 
 // An orthonormal frame (t, b, n) around the unit vector n (Duff et al. 2017,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "scene/det_math.h"
 #include "shading/ibl/ibl_sampling.h"
 
 namespace prast {
@@ -27,7 +28,7 @@ std::vector<std::vector<Tap>> overlap_taps(int n_in, int n_out, bool solid_angle
         for (int j = int(std::floor(a)); j < n_in && double(j) < b; ++j) {
             const double lo = std::max(a, double(j)), hi = std::min(b, double(j + 1));
             if (!(hi > lo)) continue;
-            const double w = solid_angle ? std::cos(M_PI * lo / n_in) - std::cos(M_PI * hi / n_in) : hi - lo;
+            const double w = solid_angle ? det::cos(M_PI * lo / n_in) - det::cos(M_PI * hi / n_in) : hi - lo;
             taps[std::size_t(o)].push_back({j, w});
             total += w;
         }
@@ -44,8 +45,8 @@ void resample_equirect(glm::vec4* texels, const EquirectLevel& in, const Equirec
         // texel averages a 2x2 block, its two rows weighted by their solid
         // angles; the same result as the general path below, faster.
         pool.run(out.h, [&](int y, int) {
-            const double c0 = std::cos(M_PI * (2 * y) / in.h), c1 = std::cos(M_PI * (2 * y + 1) / in.h);
-            const double c2 = std::cos(M_PI * (2 * y + 2) / in.h);
+            const double c0 = det::cos(M_PI * (2 * y) / in.h), c1 = det::cos(M_PI * (2 * y + 1) / in.h);
+            const double c2 = det::cos(M_PI * (2 * y + 2) / in.h);
             const double w0 = (c0 - c1) / (c0 - c2), w1 = (c1 - c2) / (c0 - c2);
             const glm::vec4* a = texels + in.offset + std::size_t(2 * y) * std::size_t(in.w);
             const glm::vec4* b = a + in.w;
@@ -103,12 +104,12 @@ void prefilter_ggx(glm::vec4* texels, const EquirectLevel* mips, int mip_count, 
         const double pdf = D_GGX_d(NoH, alpha) * 0.25;
         const double omega_s = 1.0 / (double(samples) * pdf);
         // lod = log4(4 omega_s / omega_p): the +1 (log4 4) lets neighbouring samples' footprints overlap.
-        list.push_back({{2.0 * NoH * h.x, 2.0 * NoH * h.y, NoL}, NoL, 0.5 * std::log2(omega_s / omega_equator) + 1.0});
+        list.push_back({{2.0 * NoH * h.x, 2.0 * NoH * h.y, NoL}, NoL, 0.5 * det::log2(omega_s / omega_equator) + 1.0});
         weight += NoL;
     }
     // A texel's solid angle shrinks with sin(theta); below half a row from the
     // pole, use the pole row's.
-    const double min_sin = std::sin(0.5 * M_PI / double(base.h));
+    const double min_sin = det::sin(0.5 * M_PI / double(base.h));
     const double top = double(mip_count - 1);
 
     // Turning a direction about +Y only shifts its u: the samples of texel x
@@ -129,10 +130,10 @@ void prefilter_ggx(glm::vec4* texels, const EquirectLevel* mips, int mip_count, 
         for (const Sample& s : list) {
             const glm::dvec3 l = glm::normalize(frame.to_world(s.l));
             Tap t;
-            t.u0 = 0.5 + std::atan2(l.x, -l.z) / (2.0 * M_PI);
-            const double v = std::acos(std::clamp(l.y, -1.0, 1.0)) / M_PI;
+            t.u0 = 0.5 + det::atan2(l.x, -l.z) / (2.0 * M_PI);
+            const double v = det::acos(std::clamp(l.y, -1.0, 1.0)) / M_PI;
             const double sin_theta = std::max(std::sqrt(l.x * l.x + l.z * l.z), min_sin);
-            const double lod = std::clamp(s.lod - 0.5 * std::log2(sin_theta), 0.0, top);
+            const double lod = std::clamp(s.lod - 0.5 * det::log2(sin_theta), 0.0, top);
             const int la = int(lod), lb = std::min(la + 1, mip_count - 1);
             t.t = float(lod - la);
             t.weight = float(s.NoL / weight);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 ShIrradiance project_sh_irradiance(const glm::vec4* texels, const EquirectLevel& level, float rot_cos,
@@ -14,7 +16,7 @@ ShIrradiance project_sh_irradiance(const glm::vec4* texels, const EquirectLevel&
         double* acc = &rows[std::size_t(y) * 27];
         // Texel solid angle: (2 pi / W) (cos theta_top - cos theta_bottom), exact for the row.
         const double t0 = M_PI * y / H, t1 = M_PI * (y + 1) / H;
-        const double d_omega = 2.0 * M_PI / W * (std::cos(t0) - std::cos(t1));
+        const double d_omega = 2.0 * M_PI / W * (det::cos(t0) - det::cos(t1));
         for (int x = 0; x < W; ++x) {
             const glm::dvec3 m = equirect_direction((x + 0.5) / W, (y + 0.5) / H);
             // World direction of the texel: R_y(angle) applied to the map direction.

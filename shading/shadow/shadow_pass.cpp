@@ -7,6 +7,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "scene/det_math.h"
+
 namespace prast {
 
 namespace {
@@ -174,7 +176,7 @@ ShadowMap fit_directional_shadow(const glm::vec3& toward_light, const Bounds& sc
     const glm::dvec3 fwd = glm::normalize(glm::dvec3(camera.target) - eye);
     const glm::dvec3 right = glm::normalize(glm::cross(fwd, glm::dvec3(camera.up)));
     const glm::dvec3 up = glm::cross(right, fwd);
-    const double tan_half = std::tan(glm::radians(double(camera.fov_y_deg)) * 0.5);
+    const double tan_half = det::tan(glm::radians(double(camera.fov_y_deg)) * 0.5);
     glm::dvec2 flo(1e300), fhi(-1e300);
     for (int c = 0; c < 8; ++c) {
         const double d = (c & 4) ? double(camera.far_plane) : double(camera.near_plane);
@@ -196,10 +198,10 @@ ShadowMap fit_directional_shadow(const glm::vec3& toward_light, const Bounds& sc
     // the visible rectangle (at most 6 octaves).
     const double whole = std::max({shi.x - slo.x, shi.y - slo.y, 1e-6 * (1.0 + glm::length(origin))});
     const double needed = std::max({hi.x - lo.x, hi.y - lo.y, whole / 64.0});
-    int steps = int(std::floor(4.0 * std::log2(whole / needed)));
+    int steps = int(std::floor(4.0 * det::log2(whole / needed)));
     steps = std::clamp(steps, 0, 24);
-    while (steps > 0 && whole * std::exp2(-steps / 4.0) < needed) --steps;
-    const double side = whole * std::exp2(-steps / 4.0);
+    while (steps > 0 && whole * det::exp2(-steps / 4.0) < needed) --steps;
+    const double side = whole * det::exp2(-steps / 4.0);
     // Three texels of margin each side for the PCF footprint; the centre
     // snapped to whole texels.
     const double texel = side / double(size - 6);
