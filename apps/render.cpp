@@ -212,7 +212,7 @@ struct PixelHit {
 class PixelWinner {
 public:
     PixelWinner(int x, int y, int samples, FrameOptions::Visibility visibility)
-        : x_(x), y_(y), bx_(x & ~(kBlockSize - 1)), by_(y & ~(kBlockSize - 1)), samples_(samples), visibility_(visibility) {
+        : bx_(x & ~(kBlockSize - 1)), by_(y & ~(kBlockSize - 1)), samples_(samples), visibility_(visibility) {
         for (int l = 0; l < kBlockLanes; ++l)
             if (lane_x(l) == x - bx_ && lane_y(l) == y - by_) lane_ = l;
     }
@@ -303,7 +303,7 @@ private:
         pending_samples_ = 0;
     }
 
-    int x_, y_, bx_, by_, lane_ = 0, samples_;
+    int bx_, by_, lane_ = 0, samples_;
     FrameOptions::Visibility visibility_;
     std::vector<SceneDraw> draws_;
     std::vector<bool> visible_;

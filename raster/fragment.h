@@ -39,8 +39,10 @@ struct FragmentBlock {
     // top row of the quad, y from its left column, at the pixel centres.
     // (centre_var is only read when centroid_mask says it was written, which
     // GCC cannot see through the rasterizer's calls.)
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
     float ddx(int k, int lane) const {
         const int q = lane & ~3;
         if (centroid_mask) return centre_var[k][q + 1] - centre_var[k][q];
@@ -51,7 +53,9 @@ struct FragmentBlock {
         if (centroid_mask) return centre_var[k][q + 2] - centre_var[k][q];
         return var[k][q + 2] - var[k][q];
     }
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 };
 
 // Batches. A program may also define

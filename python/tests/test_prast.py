@@ -272,3 +272,53 @@ def test_warnings_are_python_warnings(tmp_path):
         scene.render(size=(16, 16))
     said = [str(w.message) for w in caught if issubclass(w.category, prast.PrastWarning)]
     assert [w for w in said if "KHR_materials_anisotropy" in w] == [w for w in cli_warnings if "KHR_materials_anisotropy" in w]
+
+
+def test_fuzzed_arrays_and_arguments_never_crash():
+    """Seeded random meshes (shapes, NaN, infinities, huge and negative values, wrong dtypes) and random keyword
+    values: each either renders a finite image or raises one of prast's errors (or numpy's TypeError or
+    ValueError for what is not an array at all), never crashes the interpreter."""
+    rng = np.random.default_rng(26)
+    specials = np.array([0.0, 1.0, -1.0, np.nan, np.inf, -np.inf, 1e30, -1e30, 1e-30])
+    accepted = 0
+    for i in range(800):
+        n = int(rng.integers(3, 13)) if rng.random() < 0.8 else int(rng.integers(0, 3))
+        shape = (n, 3) if rng.random() < 0.7 else [(n, 2), (n,), (n, 3, 1), (n, 4)][int(rng.integers(0, 4))]
+        pos = rng.normal(size=shape) * 10.0 ** float(rng.integers(-3, 4))
+        if rng.random() < 0.3 and pos.size:
+            pos.flat[int(rng.integers(0, pos.size))] = specials[int(rng.integers(0, len(specials)))]
+        kwargs = {}
+        if rng.random() < 0.3:  # junk indices
+            kwargs["indices"] = rng.integers(-2, max(n, 1) + 2, size=int(rng.integers(0, 9)))
+        elif rng.random() < 0.5:  # valid ones
+            kwargs["indices"] = rng.integers(0, max(n, 1), size=3 * int(rng.integers(1, 5)))
+        elif n % 3:
+            continue
+        if rng.random() < 0.3:
+            kwargs["uvs"] = rng.normal(size=(n, 2 if rng.random() < 0.7 else int(rng.integers(1, 4))))
+        if rng.random() < 0.3:
+            kwargs["normals"] = rng.normal(size=(n, 3)) * (rng.random() < 0.8)
+        if rng.random() < 0.3:
+            kwargs["texture"] = rng.integers(0, 256, size=(int(rng.integers(0, 5)), int(rng.integers(1, 5)),
+                                                           int(rng.integers(1, 6))), dtype=np.uint8)
+        if rng.random() < 0.2:
+            kwargs["base_color"] = tuple(rng.normal(size=int(rng.integers(3, 6))))
+        if rng.random() < 0.2:
+            kwargs["roughness"] = float(specials[int(rng.integers(0, len(specials)))])
+        try:
+            scene = prast.mesh(pos, **kwargs)
+        except (prast.Error, TypeError, ValueError):
+            continue
+        size = (int(rng.integers(1, 24)), int(rng.integers(1, 24)))
+        view = {}
+        if rng.random() < 0.5:
+            view["eye"] = tuple(rng.normal(size=3) * 5)
+        if rng.random() < 0.3:
+            view["fov"] = float(rng.choice([0.0, 1e-4, 45.0, 179.9, 180.0, np.nan, -5.0]))
+        try:
+            img = prast.render(scene, size=size, msaa=int(rng.choice([1, 2, 4, 8])), threads=2, **view)
+        except prast.Error:
+            continue
+        assert img.shape == (size[1], size[0], 4) and img.dtype == np.uint8
+        accepted += 1
+    assert accepted > 40  # the loop reaches the renderer, not only the checks
