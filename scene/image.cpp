@@ -22,6 +22,7 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#include <libdeflate.h>
 #include <png.h>
 #include <zlib.h>
 #include <stb_image.h>
@@ -216,6 +217,48 @@ bool unfilter_row(int filter, const unsigned char* raw, const unsigned char* abo
     }
 }
 
+// decode_png_fast's first try: true when libdeflate inflated the whole
+// image and every row unfiltered into img.pixels (sized by the caller);
+// false for anything else, which the zlib path then reads and reports.
+bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h, int channels, Image& img) {
+    const std::size_t stride = std::size_t(w) * std::size_t(channels);
+    const std::size_t raw_size = (stride + 1) * std::size_t(h);
+    std::vector<unsigned char> compressed;
+    for (std::size_t pos = 8; pos + 12 <= size;) {
+        const std::uint32_t len = be32(data + pos);
+        if (len > size - pos - 12) return false;
+        const unsigned char* type = data + pos + 4;
+        if (std::uint32_t(crc32(0L, type, uInt(len + 4))) != be32(data + pos + 8 + len)) return false;
+        if (std::memcmp(type, "IDAT", 4) == 0) compressed.insert(compressed.end(), type + 4, type + 4 + len);
+        else if (!compressed.empty() || std::memcmp(type, "IEND", 4) == 0) break;  // IDATs are consecutive
+        pos += 12 + std::size_t(len);
+    }
+    // The zlib header (RFC 1950): deflate, window <= 32 KiB, no preset dictionary.
+    if (compressed.size() < 2 || (compressed[0] & 0x0F) != 8 || (compressed[0] >> 4) > 7 || (compressed[1] & 0x20) ||
+        (unsigned(compressed[0]) * 256u + compressed[1]) % 31u != 0)
+        return false;
+    struct Free {
+        void operator()(libdeflate_decompressor* d) const { libdeflate_free_decompressor(d); }
+    };
+    const std::unique_ptr<libdeflate_decompressor, Free> inflater(libdeflate_alloc_decompressor());
+    if (!inflater) return false;
+    std::vector<unsigned char> raw(raw_size);
+    std::size_t in_used = 0, out_made = 0;
+    // The raw deflate stream after the header; its Adler-32 is not checked
+    // (the chunk CRCs guard the bytes), as on the zlib path.
+    if (libdeflate_deflate_decompress_ex(inflater.get(), compressed.data() + 2, compressed.size() - 2, raw.data(),
+                                         raw_size, &in_used, &out_made) != LIBDEFLATE_SUCCESS ||
+        out_made != raw_size)
+        return false;
+    compressed = {};
+    for (int y = 0; y < h; ++y) {
+        const unsigned char* r = raw.data() + std::size_t(y) * (stride + 1);
+        unsigned char* row = img.pixels.data() + std::size_t(y) * stride;
+        if (!unfilter_row(r[0], r + 1, y > 0 ? row - stride : nullptr, row, stride, channels)) return false;
+    }
+    return true;
+}
+
 FastPng decode_png_fast(const unsigned char* data, std::size_t size, int w, int h, Image& img, std::string& error) {
     // Walk the chunk headers first: is this a PNG of the common kind?
     if (size < 8 + 25) return FastPng::NotMine;
@@ -242,14 +285,28 @@ FastPng decode_png_fast(const unsigned char* data, std::size_t size, int w, int 
     }
     if (!channels || !seen_idat) return FastPng::NotMine;
 
+    const std::size_t stride = std::size_t(w) * std::size_t(channels);
+    img.pixels.resize(stride * std::size_t(h) + 4);  // 4 spare bytes for the 4-byte reads
+    // First libdeflate, in one call over the whole image (2 to 3 times zlib's
+    // speed): the IDAT data gathered, every CRC checked, the zlib header
+    // checked, the rows inflated into one buffer of exactly the image's size
+    // (more data, or less, is refused there) and unfiltered. Whatever it does
+    // not take (a damaged stream, data past the pixels) goes on to zlib below,
+    // which names the problem as it always has.
+    if (inflate_png_whole(data, size, w, h, channels, img)) {
+        img.pixels.resize(stride * std::size_t(h));
+        img.width = w;
+        img.height = h;
+        img.channels = channels;
+        return FastPng::Done;
+    }
+
     // Inflate the IDAT chunks into `raw`, many rows at a time (zlib copies
     // what each call writes into its 32 KiB window: calls of a few hundred KiB
     // keep that copy small), and unfilter them. The zlib header is read here
     // and the data inflated raw: the chunk CRCs already guard the bytes, so
     // the Adler-32 of the pixels (7% of the decode) is not computed.
-    const std::size_t stride = std::size_t(w) * std::size_t(channels);
     const std::size_t rows_per_call = std::max<std::size_t>(1, (std::size_t(256) << 10) / (stride + 1));
-    img.pixels.resize(stride * std::size_t(h) + 4);  // 4 spare bytes for the 4-byte reads
     std::vector<unsigned char> raw((stride + 1) * std::min<std::size_t>(rows_per_call, std::size_t(h)) + 4, 0);
     z_stream z{};
     if (inflateInit2(&z, -15) != Z_OK) {

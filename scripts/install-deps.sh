@@ -1,6 +1,7 @@
 #!/bin/sh
 # Installs the Debian 12 packages prast builds with (compiler, CMake, the
-# header-only libraries, and zlib, libpng, libwebp and libdraco, linked statically;
+# header-only libraries, and zlib, libpng, libdeflate, libwebp and libdraco,
+# linked statically;
 # libmeshoptimizer only for the tests, which encode with it; pybind11, the
 # Python headers and numpy for the Python module, pytest for its tests). Runs apt-get through sudo unless already root.
 set -e
@@ -22,6 +23,7 @@ PACKAGES="
   pkg-config
   libdraco-dev
   libwebp-dev
+  libdeflate-dev
   libmeshoptimizer-dev
   pybind11-dev
   python3-dev

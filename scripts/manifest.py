@@ -209,7 +209,10 @@ def render_one(render_cmd, name, args, work):
         return name, None, "skipped: %s is absent" % missing
     png = os.path.join(work, name + ".png")
     cmd = render_cmd + resolved + ["-o", png]
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    except OSError as e:
+        return name, None, "render failed: cannot run %s (%s)" % (cmd[0], e.strerror)
     if p.returncode != 0:
         return name, None, "render failed (exit %d): %s\n  %s" % (p.returncode, p.stderr.strip(), shlex.join(cmd))
     with open(png, "rb") as f:

@@ -12,6 +12,7 @@
 
 #include <png.h>
 #include <stb_image.h>
+#include <zlib.h>
 
 #include "scene/image.h"
 
@@ -77,9 +78,88 @@ std::vector<unsigned char> write_flavour(const Flavour& f, int w, int h, std::mt
     return out;
 }
 
+std::uint32_t be32(const unsigned char* p) {
+    return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 | std::uint32_t(p[3]);
+}
+void put_chunk(std::vector<unsigned char>& out, const char* type, const unsigned char* data, std::size_t n) {
+    for (int k = 3; k >= 0; --k) out.push_back(static_cast<unsigned char>(n >> (8 * k)));
+    const std::size_t at = out.size();
+    out.insert(out.end(), type, type + 4);
+    out.insert(out.end(), data, data + n);
+    const std::uint32_t crc = std::uint32_t(crc32(0L, out.data() + at, uInt(n + 4)));
+    for (int k = 3; k >= 0; --k) out.push_back(static_cast<unsigned char>(crc >> (8 * k)));
+}
+// The PNG with its IDAT data (the zlib stream) replaced by edit(stream),
+// written as IDAT chunks of `piece` bytes.
+template <class Edit>
+std::vector<unsigned char> restream(const std::vector<unsigned char>& png, std::size_t piece, Edit edit) {
+    std::vector<unsigned char> stream, out(png.begin(), png.begin() + 8);
+    std::size_t pos = 8;
+    bool written = false;
+    while (pos + 12 <= png.size()) {
+        const std::uint32_t len = be32(&png[pos]);
+        const char* type = reinterpret_cast<const char*>(&png[pos + 4]);
+        if (std::string(type, 4) == "IDAT") {
+            stream.insert(stream.end(), png.begin() + std::ptrdiff_t(pos + 8), png.begin() + std::ptrdiff_t(pos + 8 + len));
+        } else {
+            if (!stream.empty() && !written) {
+                const std::vector<unsigned char> s = edit(stream);
+                for (std::size_t at = 0; at < s.size(); at += piece)
+                    put_chunk(out, "IDAT", s.data() + at, std::min(piece, s.size() - at));
+                written = true;
+            }
+            put_chunk(out, type, &png[pos + 8], len);
+        }
+        pos += 12 + len;
+    }
+    return out;
+}
+
 } // namespace
 
 TEST_SUITE("texture") {
+
+TEST_CASE("PNG image data: libdeflate's whole-image inflate and zlib's rows give the same image and errors") {
+    std::mt19937 rng(9u);
+    for (const Flavour& f : {Flavour{"RGB", PNG_COLOR_TYPE_RGB, 8, false, false},
+                             Flavour{"RGBA", PNG_COLOR_TYPE_RGBA, 8, false, false},
+                             Flavour{"grey", PNG_COLOR_TYPE_GRAY, 8, false, false}}) {
+        INFO(f.name);
+        const std::vector<unsigned char> png = write_flavour(f, 61, 37, rng);
+        int w = 0, h = 0, comp = 0;
+        stbi_uc* ref = stbi_load_from_memory(png.data(), int(png.size()), &w, &h, &comp, 0);
+        REQUIRE(ref != nullptr);
+        const std::vector<std::uint8_t> want(ref, ref + std::size_t(w) * std::size_t(h) * std::size_t(comp));
+        stbi_image_free(ref);
+        auto decode = [](const std::vector<unsigned char>& bytes) {
+            ImageSource src;
+            src.bytes = bytes;
+            src.name = "p.png";
+            return decode_image(src, false);
+        };
+        const auto same = [](const std::vector<unsigned char>& s) { return s; };
+        // One IDAT or many small ones.
+        for (std::size_t piece : {std::size_t(1) << 20, std::size_t(7), std::size_t(1)})
+            CHECK(decode(restream(png, piece, same)).pixels == want);
+        // Bytes after the end of the deflate stream: ignored by both.
+        const std::vector<unsigned char> trailing = restream(png, 100, [](std::vector<unsigned char> s) {
+            s.insert(s.end(), {1, 2, 3, 4, 5});
+            return s;
+        });
+        CHECK(decode(trailing).pixels == want);
+        // A stream cut short, or damaged: refused, with the zlib path's words.
+        const std::vector<unsigned char> cut = restream(png, 100, [](std::vector<unsigned char> s) {
+            s.resize(s.size() / 2);
+            return s;
+        });
+        CHECK_THROWS_WITH(decode(cut), doctest::Contains("p.png: cannot decode PNG image: truncated image data"));
+        const std::vector<unsigned char> damaged = restream(png, 100, [](std::vector<unsigned char> s) {
+            for (std::size_t i = 2; i < s.size(); i += 3) s[i] = static_cast<unsigned char>(s[i] ^ 0x5A);
+            return s;
+        });
+        CHECK_THROWS_WITH(decode(damaged), doctest::Contains("p.png: cannot decode PNG image: corrupt image data"));
+    }
+}
 
 TEST_CASE("libpng decodes every 8-bit PNG flavour exactly as stb_image does") {
     const Flavour flavours[] = {
