@@ -78,6 +78,10 @@ def mesh(positions, indices=None, normals=None, uvs=None, base_color=(0.8, 0.8, 
     vertices a triangle); normals (N, 3) (None: smooth ones, area-weighted); uvs (N, 2), v = 0 at the top of the
     texture as in glTF; base_color linear RGBA, times `texture`, an sRGB (H, W, 3|4) uint8 array;
     metallic and roughness factors. Counter-clockwise triangles face the camera."""
+    if indices is not None:
+        indices = np.asarray(indices)
+        if indices.dtype.kind not in "iu":
+            raise UsageError("mesh '%s': indices must be integers, not %s" % (name, indices.dtype))
     return Scene(_prast.mesh_scene(str(name), np.asarray(positions, dtype=np.float32), indices,
                                    normals, uvs, [float(c) for c in base_color], texture,
                                    float(metallic), float(roughness), bool(double_sided)))

@@ -165,6 +165,7 @@ def test_mesh_from_arrays_equals_the_same_gltf(tmp_path):
     (dict(positions=np.array([[0, 0, 0], [1, 0, 0], [np.nan, 1, 0]])), "not a finite number"),
     (dict(positions=np.eye(3), indices=[0, 1, 3]), "outside the 3 vertices"),
     (dict(positions=np.eye(3), indices=[0, 1]), "indices must be"),
+    (dict(positions=np.eye(3), indices=[0.0, 1.5, 2.0]), "indices must be integers"),
     (dict(positions=np.eye(3), uvs=np.zeros((2, 2))), "uvs must be"),
     (dict(positions=np.eye(3), normals=np.zeros((3, 3))), "normal 0 is zero"),
     (dict(positions=np.eye(3), texture=np.zeros((4, 4, 3), np.uint8)), "a texture needs uvs"),
