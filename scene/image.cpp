@@ -242,7 +242,7 @@ bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h
     };
     const std::unique_ptr<libdeflate_decompressor, Free> inflater(libdeflate_alloc_decompressor());
     if (!inflater) return false;
-    std::vector<unsigned char> raw(raw_size);
+    std::vector<unsigned char> raw(raw_size + 4);  // 4 spare bytes for unfilter_row's 4-byte reads
     std::size_t in_used = 0, out_made = 0;
     // The raw deflate stream after the header; its Adler-32 is not checked
     // (the chunk CRCs guard the bytes), as on the zlib path.
