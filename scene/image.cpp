@@ -219,10 +219,15 @@ bool unfilter_row(int filter, const unsigned char* raw, const unsigned char* abo
 
 // decode_png_fast's first try: true when libdeflate inflated the whole
 // image and every row unfiltered into img.pixels (sized by the caller);
-// false for anything else, which the zlib path then reads and reports.
+// false for anything else (and for images over 128 MiB of rows), which the
+// zlib path then reads and reports.
 bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h, int channels, Image& img) {
     const std::size_t stride = std::size_t(w) * std::size_t(channels);
     const std::size_t raw_size = (stride + 1) * std::size_t(h);
+    // The image's filtered rows are held whole next to its pixels: beyond
+    // 128 MiB (a 5,792-texel RGBA square) the zlib path's 256 KiB at a time
+    // keeps a huge texture's decode within what the memory plan counted.
+    if (raw_size > (std::size_t(128) << 20)) return false;
     std::vector<unsigned char> compressed;
     for (std::size_t pos = 8; pos + 12 <= size;) {
         const std::uint32_t len = be32(data + pos);
