@@ -9,10 +9,15 @@ cd "$(dirname "$0")/../.."
 start=$(date +%s)
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-if ! /usr/bin/python3 -c "import ensurepip" 2>/dev/null; then
-  echo "installing: python3-venv"
+missing=""
+for p in python3-venv python3-pip python3-setuptools python3-wheel; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "installing:$missing"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq python3-venv
+  # shellcheck disable=SC2086
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing
 fi
 venv=$(mktemp -d)
 trap 'rm -rf "$venv"' EXIT
