@@ -1,7 +1,7 @@
 // Texture binding and frame rendering for a Scene; see scene_renderer.h.
 #include "renderer/scene_renderer.h"
-#include "scene/det_math.h"
 #include "renderer/draw_order.h"
+#include "scene/det_math.h"
 
 #include <algorithm>
 #include <cmath>
@@ -428,11 +428,14 @@ void apply_tile_overlay(Framebuffer& fb, const std::vector<std::uint32_t>& entri
     int tiles_x = (fb.width + tile_size - 1) / tile_size;
     std::uint32_t most = 1;
     for (std::uint32_t e : entries) most = std::max(most, e);
+    // Once a tile: det::log2 is a series, not an instruction.
+    std::vector<float> heats(entries.size(), 0.0f);
+    for (std::size_t t = 0; t < entries.size(); ++t)
+        if (entries[t] > 0) heats[t] = float(det::log2(1.0 + entries[t]) / det::log2(1.0 + most));
     for (int y = 0; y < fb.height; ++y)
         for (int x = 0; x < fb.width; ++x) {
             std::size_t t = std::size_t(y / tile_size) * tiles_x + x / tile_size;
-            float heat = t < entries.size() && entries[t] > 0
-                             ? float(det::log2(1.0 + entries[t]) / det::log2(1.0 + most)) : 0.0f;
+            float heat = t < heats.size() ? heats[t] : 0.0f;
             float* c = fb.pixel(x, y);
             glm::vec3 tint = glm::mix(glm::vec3(0.1f, 0.2f, 1.0f), glm::vec3(1.0f, 0.15f, 0.05f), heat);
             bool border = x % tile_size == 0 || y % tile_size == 0;
