@@ -24,15 +24,7 @@ SYSROOT="${PRAST_AARCH64_SYSROOT:-/opt/prast-aarch64-sysroot}"
 # libstdc++-12-dev-arm64-cross, with libc.a for a -static link) come with the
 # cross compiler.
 HOST_PACKAGES="g++-aarch64-linux-gnu qemu-user"
-missing=""
-for p in $HOST_PACKAGES; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
-done
-if [ -n "$missing" ]; then
-  echo "installing:$missing"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing
-fi
+sh "$(dirname "$0")/install-packages.sh" $HOST_PACKAGES
 
 # arm64 package lists, for `apt-get download`; adding the architecture
 # installs nothing.

@@ -4,15 +4,5 @@
 # Debian packages it needs, then runs it; here it may not be skipped.
 set -e
 cd "$(dirname "$0")/../.."
-SUDO=""
-[ "$(id -u)" -eq 0 ] || SUDO="sudo"
-missing=""
-for p in chromium chromium-driver python3-selenium; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
-done
-if [ -n "$missing" ]; then
-  echo "installing:$missing"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing
-fi
+sh scripts/install-packages.sh chromium chromium-driver python3-selenium
 PRAST_BROWSER_REQUIRED=1 ctest --test-dir build -R '^browser$' --output-on-failure

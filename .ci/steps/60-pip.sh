@@ -7,18 +7,7 @@
 set -e
 cd "$(dirname "$0")/../.."
 start=$(date +%s)
-SUDO=""
-[ "$(id -u)" -eq 0 ] || SUDO="sudo"
-missing=""
-for p in python3-venv python3-pip python3-setuptools python3-wheel; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
-done
-if [ -n "$missing" ]; then
-  echo "installing:$missing"
-  $SUDO apt-get update -qq
-  # shellcheck disable=SC2086
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing
-fi
+sh scripts/install-packages.sh python3-venv python3-pip python3-setuptools python3-wheel
 venv=$(mktemp -d)
 trap 'rm -rf "$venv"' EXIT
 /usr/bin/python3 -m venv --system-site-packages "$venv"
