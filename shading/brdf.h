@@ -160,20 +160,13 @@ inline ConductorIOR conductor_ior(Conductor c) {
 
 // ---- Sheen (KHR_materials_sheen)
 
-namespace brdf_detail {
-// exp, log and pow of scene/det_math.h, so the sheen's powers do not depend
-// on which libm variant the CPU selects.
-inline double det_exp(double x) { return det::exp(x); }
-inline double det_log(double x) { return det::log(x); }
-inline double det_pow(double x, double y) { return det::pow(x, y); }
-} // namespace brdf_detail
-
 // The "Charlie" sheen distribution (Conty Estevez and Kulla 2017), alpha =
-// r^2: (2 + 1/alpha) sin(theta_h)^(1/alpha) / (2 pi).
+// r^2: (2 + 1/alpha) sin(theta_h)^(1/alpha) / (2 pi). The sheen's powers are
+// scene/det_math.h's, so that they do not depend on the CPU's libm variant.
 inline double D_Charlie(double NoH, double alpha) {
     const double inv = 1.0 / alpha;
     const double sin2 = 1.0 - NoH * NoH;
-    return (2.0 + inv) * brdf_detail::det_pow(sin2, 0.5 * inv) / (2.0 * glm::pi<double>());
+    return (2.0 + inv) * det::pow(sin2, 0.5 * inv) / (2.0 * glm::pi<double>());
 }
 
 // Their visibility, with the fitted Lambda the extension gives.
@@ -183,10 +176,10 @@ inline double sheen_lambda(double cos_theta, double alpha) {
         const double a = 21.5473 + (25.3245 - 21.5473) * t, b = 3.82987 + (3.32435 - 3.82987) * t;
         const double c = 0.19823 + (0.16801 - 0.19823) * t, d = -1.97760 + (-1.27393 + 1.97760) * t;
         const double e = -4.32054 + (-4.85967 + 4.32054) * t;
-        return a / (1.0 + b * brdf_detail::det_pow(x, c)) + d * x + e;
+        return a / (1.0 + b * det::pow(x, c)) + d * x + e;
     };
-    return cos_theta < 0.5 ? brdf_detail::det_exp(l(cos_theta))
-                           : brdf_detail::det_exp(2.0 * l(0.5) - l(1.0 - cos_theta));
+    return cos_theta < 0.5 ? det::exp(l(cos_theta))
+                           : det::exp(2.0 * l(0.5) - l(1.0 - cos_theta));
 }
 inline double V_Charlie(double NoV, double NoL, double alpha) {
     const double den = (1.0 + sheen_lambda(NoV, alpha) + sheen_lambda(NoL, alpha)) * (4.0 * NoV * NoL);
@@ -342,13 +335,13 @@ inline float transmission_roughness(float r, float ior) {
 // KHR_materials_volume's Beer-Lambert attenuation over a path of length
 // `thickness`: per channel exp(-sigma d) with sigma = -ln(colour) / distance,
 // i.e. colour^(d / distance); 1 for a thin wall (thickness 0) or an infinite
-// distance (0). In double with the sheen's own exp and log (no libm variant
-// changes a pixel), rounded once.
+// distance (0). In double with det::pow (no libm variant changes a pixel),
+// rounded once.
 inline glm::vec3 volume_transmittance(float thickness, float distance, const glm::vec3& color) {
     if (!(thickness > 0.0f) || !(distance > 0.0f)) return glm::vec3(1.0f);
     glm::vec3 t;
     for (int c = 0; c < 3; ++c)
-        t[c] = color[c] > 0.0f ? float(brdf_detail::det_pow(double(color[c]), double(thickness) / double(distance)))
+        t[c] = color[c] > 0.0f ? float(det::pow(double(color[c]), double(thickness) / double(distance)))
                                : 0.0f;
     return t;
 }
