@@ -217,6 +217,12 @@ bool unfilter_row(int filter, const unsigned char* raw, const unsigned char* abo
     }
 }
 
+// The zlib header (RFC 1950) of a PNG's image data: deflate, a window of at
+// most 32 KiB, no preset dictionary, its check bits right.
+bool png_zlib_header_ok(unsigned char cmf, unsigned char flg) {
+    return (cmf & 0x0F) == 8 && (cmf >> 4) <= 7 && !(flg & 0x20) && (unsigned(cmf) * 256u + flg) % 31u == 0;
+}
+
 // decode_png_fast's first try: true when libdeflate inflated the whole
 // image and every row unfiltered into img.pixels (sized by the caller);
 // false for anything else (and for images over 128 MiB of rows), which the
@@ -238,10 +244,7 @@ bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h
         else if (!compressed.empty() || std::memcmp(type, "IEND", 4) == 0) break;  // IDATs are consecutive
         pos += 12 + std::size_t(len);
     }
-    // The zlib header (RFC 1950): deflate, window <= 32 KiB, no preset dictionary.
-    if (compressed.size() < 2 || (compressed[0] & 0x0F) != 8 || (compressed[0] >> 4) > 7 || (compressed[1] & 0x20) ||
-        (unsigned(compressed[0]) * 256u + compressed[1]) % 31u != 0)
-        return false;
+    if (compressed.size() < 2 || !png_zlib_header_ok(compressed[0], compressed[1])) return false;
     struct Free {
         void operator()(libdeflate_decompressor* d) const { libdeflate_free_decompressor(d); }
     };
@@ -346,7 +349,7 @@ FastPng decode_png_fast(const unsigned char* data, std::size_t size, int w, int 
         }
         return false;
     };
-    // The zlib header (RFC 1950): deflate, window <= 32 KiB, no preset dictionary.
+    // The zlib header's two bytes, which may straddle IDAT chunks.
     unsigned char header[2];
     for (int i = 0; i < 2; ++i) {
         while (idat_left == 0)
@@ -357,8 +360,7 @@ FastPng decode_png_fast(const unsigned char* data, std::size_t size, int w, int 
         header[i] = *idat++;
         --idat_left;
     }
-    if ((header[0] & 0x0F) != 8 || (header[0] >> 4) > 7 || (header[1] & 0x20) ||
-        (unsigned(header[0]) * 256u + header[1]) % 31u != 0) {
+    if (!png_zlib_header_ok(header[0], header[1])) {
         error = "corrupt image data (bad zlib header)";
         return FastPng::Failed;
     }

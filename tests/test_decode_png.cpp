@@ -12,8 +12,8 @@
 
 #include <png.h>
 #include <stb_image.h>
-#include <zlib.h>
 
+#include "fuzz/png_craft.h"
 #include "scene/image.h"
 
 using namespace prast;
@@ -81,38 +81,33 @@ std::vector<unsigned char> write_flavour(const Flavour& f, int w, int h, std::mt
 std::uint32_t be32(const unsigned char* p) {
     return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 | std::uint32_t(p[3]);
 }
-void put_chunk(std::vector<unsigned char>& out, const char* type, const unsigned char* data, std::size_t n) {
-    for (int k = 3; k >= 0; --k) out.push_back(static_cast<unsigned char>(n >> (8 * k)));
-    const std::size_t at = out.size();
-    out.insert(out.end(), type, type + 4);
-    out.insert(out.end(), data, data + n);
-    const std::uint32_t crc = std::uint32_t(crc32(0L, out.data() + at, uInt(n + 4)));
-    for (int k = 3; k >= 0; --k) out.push_back(static_cast<unsigned char>(crc >> (8 * k)));
-}
 // The PNG with its IDAT data (the zlib stream) replaced by edit(stream),
 // written as IDAT chunks of `piece` bytes.
 template <class Edit>
 std::vector<unsigned char> restream(const std::vector<unsigned char>& png, std::size_t piece, Edit edit) {
-    std::vector<unsigned char> stream, out(png.begin(), png.begin() + 8);
+    std::vector<unsigned char> stream;
+    std::string out(png.begin(), png.begin() + 8);
     std::size_t pos = 8;
     bool written = false;
     while (pos + 12 <= png.size()) {
         const std::uint32_t len = be32(&png[pos]);
-        const char* type = reinterpret_cast<const char*>(&png[pos + 4]);
-        if (std::string(type, 4) == "IDAT") {
-            stream.insert(stream.end(), png.begin() + std::ptrdiff_t(pos + 8), png.begin() + std::ptrdiff_t(pos + 8 + len));
+        const std::string type(reinterpret_cast<const char*>(&png[pos + 4]), 4);
+        const auto data = png.begin() + std::ptrdiff_t(pos + 8);
+        if (type == "IDAT") {
+            stream.insert(stream.end(), data, data + len);
         } else {
             if (!stream.empty() && !written) {
                 const std::vector<unsigned char> s = edit(stream);
                 for (std::size_t at = 0; at < s.size(); at += piece)
-                    put_chunk(out, "IDAT", s.data() + at, std::min(piece, s.size() - at));
+                    out += png_craft::chunk("IDAT", std::string(s.begin() + std::ptrdiff_t(at),
+                                                                s.begin() + std::ptrdiff_t(std::min(at + piece, s.size()))));
                 written = true;
             }
-            put_chunk(out, type, &png[pos + 8], len);
+            out += png_craft::chunk(type, std::string(data, data + len));
         }
         pos += 12 + len;
     }
-    return out;
+    return std::vector<unsigned char>(out.begin(), out.end());
 }
 
 } // namespace
