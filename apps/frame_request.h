@@ -55,6 +55,19 @@ inline FrameRequest render_frame_request(const RenderOptions& opt) {
     return r;
 }
 
+// Where and how `render` writes the 8-bit image of a frame for these
+// options: exposure, tone map, data views raw; the linear colour and depth
+// kept only for --pixel, which reads them.
+inline ImageOutput render_image_output(const RenderOptions& opt, std::uint8_t* rgba8) {
+    ImageOutput out;
+    out.rgba8 = rgba8;
+    out.exposure = opt.exposure;
+    out.tonemap = opt.effective_tonemap();
+    out.raw = debug_view_is_data(opt.view);
+    out.keep_framebuffer = opt.pixel.has_value();
+    return out;
+}
+
 // The frame `step` records for these options: render's frame 0, with the
 // recording in the memory plan. step explains the split sum (its --pixel is
 // not render's reference probe) and prints every warning.

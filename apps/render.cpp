@@ -607,12 +607,7 @@ int run(int argc, char** argv) {
     // streams whole cache lines (stream_fill.h) when the rows start on one.
     Rgba8Buffer rgba8_store(opt.hdr_output() ? 0 : std::size_t(opt.width) * std::size_t(opt.height));
     std::uint8_t* rgba8 = rgba8_store.data();
-    ImageOutput out8;
-    out8.rgba8 = rgba8;
-    out8.exposure = opt.exposure;
-    out8.tonemap = opt.effective_tonemap();
-    out8.raw = debug_view_is_data(opt.view);
-    out8.keep_framebuffer = opt.pixel.has_value();  // --pixel reads the linear colour and depth
+    const ImageOutput out8 = render_image_output(opt, rgba8);
     std::vector<double> frame_ms;
     std::optional<PixelWinner> winner;  // --pixel: the fragment that wrote it
     int step = 2;

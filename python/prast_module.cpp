@@ -78,6 +78,16 @@ std::shared_ptr<LoadedScene> load(const std::string& path, bool allow_outside_pa
     throw UsageError("mesh '" + name + "': " + what);
 }
 
+// An (n, width) float array of one value per vertex, or a UsageError
+// "mesh 'NAME': WHAT must be an (N, width) float array, one per position".
+FloatArray per_vertex(const py::object& obj, std::size_t n, int width, const std::string& name, const char* what) {
+    const auto a = FloatArray::ensure(obj);
+    if (!a || a.ndim() != 2 || a.shape(1) != width || std::size_t(a.shape(0)) != n)
+        bad_mesh(name, std::string(what) + " must be an (N, " + std::to_string(width) +
+                           ") float array, one per position");
+    return a;
+}
+
 // A scene of one triangle mesh from arrays: positions (N, 3), indices (M, 3)
 // or (3M,) (none: consecutive triangles), normals (N, 3) (none: smooth ones
 // computed), uvs (N, 2) in glTF's convention (v = 0 the top of the image),
@@ -119,9 +129,7 @@ std::shared_ptr<LoadedScene> mesh_scene(const std::string& name, const FloatArra
         }
     }
     if (!uvs_obj.is_none()) {
-        const auto uv = FloatArray::ensure(uvs_obj);
-        if (!uv || uv.ndim() != 2 || uv.shape(1) != 2 || std::size_t(uv.shape(0)) != n)
-            bad_mesh(name, "uvs must be an (N, 2) float array, one per position");
+        const FloatArray uv = per_vertex(uvs_obj, n, 2, name, "uvs");
         mesh.uvs.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
             mesh.uvs[i] = {uv.data()[i * 2], uv.data()[i * 2 + 1]};
@@ -130,9 +138,7 @@ std::shared_ptr<LoadedScene> mesh_scene(const std::string& name, const FloatArra
         }
     }
     if (!normals_obj.is_none()) {
-        const auto nr = FloatArray::ensure(normals_obj);
-        if (!nr || nr.ndim() != 2 || nr.shape(1) != 3 || std::size_t(nr.shape(0)) != n)
-            bad_mesh(name, "normals must be an (N, 3) float array, one per position");
+        const FloatArray nr = per_vertex(normals_obj, n, 3, name, "normals");
         mesh.normals.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
             const glm::vec3 v{nr.data()[i * 3], nr.data()[i * 3 + 1], nr.data()[i * 3 + 2]};
@@ -216,12 +222,7 @@ py::tuple render(const std::vector<std::string>& args, const std::shared_ptr<Loa
         if (CameraFault f = frame.set_frame(0, 0.0)) throw UsageError(f.message);
         Framebuffer fb = Framebuffer::deferred(opt.width, opt.height);
         Rgba8Buffer rgba8(w * h);
-        ImageOutput out8;
-        out8.rgba8 = rgba8.data();
-        out8.exposure = opt.exposure;
-        out8.tonemap = opt.effective_tonemap();
-        out8.raw = debug_view_is_data(opt.view);
-        out8.keep_framebuffer = false;
+        const ImageOutput out8 = render_image_output(opt, rgba8.data());  // --pixel was refused above
         frame.scene_renderer->render(frame.settings, fb, &out8);
         std::uint8_t* dst = image.mutable_data();
         std::memcpy(dst, rgba8.data(), w * h * 4);
