@@ -217,8 +217,13 @@ def render_one(render_cmd, name, args, work):
         return name, None, "render failed (exit %d): %s\n  %s" % (p.returncode, p.stderr.strip(), shlex.join(cmd))
     with open(png, "rb") as f:
         data = f.read()
+    return name, (hashlib.sha256(data).hexdigest(), data), None
+
+
+def size_and_blocks(data):
+    """The "WxH" and the 16x16 block hashes of a PNG's pixels (decoded only when they are needed)."""
     width, height, rows = read_png_rgba(data)
-    return name, (hashlib.sha256(data).hexdigest(), "%dx%d" % (width, height), block_hashes(width, height, rows)), None
+    return "%dx%d" % (width, height), block_hashes(width, height, rows)
 
 
 def first_difference(size, want, got):
@@ -267,11 +272,13 @@ def main():
             if err:
                 print("manifest: %s: %s" % (name, err))
                 if name in old:  # an optional file absent here keeps its line
-                    got = old[name]
+                    sha, size, blocks = old[name]
                 else:
                     failed += err.startswith("render failed")
                     continue
-            lines.append("%s %s %s %s" % (name, got[0], got[1], ",".join(got[2])))
+            else:
+                sha, (size, blocks) = got[0], size_and_blocks(got[1])
+            lines.append("%s %s %s %s" % (name, sha, size, ",".join(blocks)))
         with open(HASHES, "w") as f:
             f.write("\n".join(lines) + "\n")
         print("manifest: wrote %s (%d renders)" % (os.path.relpath(HASHES, ROOT), len(lines) - 2))
@@ -296,11 +303,12 @@ def main():
             matched += 1
             continue
         failed += 1
-        if got[1] != size:
-            print("manifest: %s: size %s, the manifest's is %s" % (name, got[1], size))
+        got_size, got_blocks = size_and_blocks(got[1])
+        if got_size != size:
+            print("manifest: %s: size %s, the manifest's is %s" % (name, got_size, size))
         else:
             print("manifest: %s: PNG differs from the manifest's: %s; the image is %s" % (
-                name, first_difference(size, blocks, got[2]), os.path.join(work, name + ".png")))
+                name, first_difference(size, blocks, got_blocks), os.path.join(work, name + ".png")))
     print("manifest: %d of %d renders match, %d differ or failed, %d skipped (%s)" % (
         matched, len(scenes), failed, skipped, " ".join(render_cmd)))
     if not opt.work and failed == 0:
