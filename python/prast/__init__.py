@@ -124,11 +124,8 @@ def _lights(value):
     return list(value)
 
 
-_UNSET = object()
-
-
 def render(model=None, size=(1280, 720), eye=None, target=None, up=None, fov=45.0, msaa=4, env=None,
-           shadows=False, tonemap=_UNSET, threads=0, time=0.0, camera=None, view="final", *, sun=(), point=(),
+           shadows=False, tonemap=None, threads=0, time=0.0, camera=None, view="final", *, sun=(), point=(),
            ambient=None, exposure=None, background=None, env_intensity=None, env_rotate=None, ibl=None,
            samples=None, brdf=None, energy=None, variant=None, animation=None, near=None, far=None,
            file_lights=None, default_lights=True, shadow_size=None, tile=None, allow_outside_paths=False, args=()):
@@ -137,10 +134,11 @@ def render(model=None, size=(1280, 720), eye=None, target=None, up=None, fov=45.
 
     model: None (the built-in scene), a path, a Scene (load, mesh) or a dict of mesh()'s arguments.
     size (w, h); eye, target, up (x, y, z); fov in degrees; msaa 1, 2, 4 or 8; env an equirectangular .hdr;
-    shadows; tonemap 'aces' (none with a view), 'neutral' or 'none'; threads 0 = all cores (the image does not
-    depend on it); time in seconds for animations; camera a file camera's name or index; view 'final' or a
-    debug view (albedo, normal, ...). sun and point: lights, each (vector, (r, g, b)), as --sun and --point.
-    The other keywords are render's flags of the same name; `args` adds raw flags (e.g. ['--ambient', '0,0,0'])."""
+    shadows; tonemap 'aces', 'neutral' or 'none' (None: render's default, aces, none with a view);
+    threads 0 = all cores (the image does not depend on it); time in seconds for animations; camera a file
+    camera's name or index; view 'final' or a debug view (albedo, normal, ...). sun and point: lights, each
+    (vector, (r, g, b)), as --sun and --point. The other keywords are render's flags of the same name;
+    `args` adds raw flags (e.g. ['--ambient', '0,0,0'])."""
     argv = []
     scene = None
     if isinstance(model, Scene):
@@ -158,7 +156,7 @@ def render(model=None, size=(1280, 720), eye=None, target=None, up=None, fov=45.
         argv += ["--env", os.fspath(env)]
     if shadows:
         argv += ["--shadows", "on"]
-    if tonemap is not _UNSET and tonemap is not None:
+    if tonemap is not None:
         argv += ["--tonemap", str(tonemap)]
     if threads:
         argv += ["--threads", str(int(threads))]
@@ -168,11 +166,9 @@ def render(model=None, size=(1280, 720), eye=None, target=None, up=None, fov=45.
         argv += ["--camera", str(camera)]
     if view and view != "final":
         argv += ["--view", str(view)]
-    lights = []
     for kind, value in (("sun", sun), ("point", point)):
         for light in _lights(value):
-            lights += _light(kind, light)
-    argv += lights
+            argv += _light(kind, light)
     numbers = {"--exposure": exposure, "--env-intensity": env_intensity, "--env-rotate": env_rotate,
                "--near": near, "--far": far}
     for flag, value in numbers.items():
