@@ -1,5 +1,5 @@
 // libFuzzer harness: image decoding (scene/image.cpp: our PNG decoder and
-// libpng, stb_image behind the HDR and JPEG guards, libwebp), one build per
+// libpng, libjpeg-turbo, stb_image behind the HDR guard, libwebp), one build per
 // format: PRAST_FUZZ_PNG, PRAST_FUZZ_JPEG, PRAST_FUZZ_HDR or PRAST_FUZZ_WEBP
 // (fuzz/targets.h: run_image).
 #include "fuzz/targets.h"

@@ -1,8 +1,10 @@
 // Image decoding: 8-bit PNG through libpng and zlib (linked statically: their
-// inflate and row filters are several times faster than stb_image's), WebP
-// through libwebp (static too; EXT_texture_webp), every
-// other format (JPEG, HDR, 16-bit PNG, ...) through stb_image. 8-bit files
-// keep their bytes, 16-bit and HDR files become linear float RGBA; see image.h.
+// inflate and row filters are several times faster than stb_image's), JPEG
+// through libjpeg-turbo's TurboJPEG API (static; its SIMD inverse DCT,
+// upsampling and colour conversion give the bytes of its C code on every
+// CPU), WebP through libwebp (static too; EXT_texture_webp), every other
+// format (HDR, 16-bit PNG, BMP, ...) through stb_image. 8-bit files keep their
+// bytes, 16-bit and HDR files become linear float RGBA; see image.h.
 #include "scene/image.h"
 
 #include <array>
@@ -26,13 +28,13 @@
 #include <png.h>
 #include <zlib.h>
 #include <stb_image.h>
+#include <turbojpeg.h>
 #include <webp/decode.h>
 #include <unistd.h>
 
 #include "scene/det_math.h"
 #include "scene/file_access.h"
 #include "scene/hdr_guard.h"
-#include "scene/jpeg_guard.h"
 #include "scene/messages.h"
 
 namespace prast {
@@ -581,14 +583,10 @@ std::string png_data_shortfall(const unsigned char* data, std::size_t size, int 
 // "" when stb_image 2.27 may see these bytes; else "cannot decode FORMAT
 // image: why".
 std::string stb_unsafe(const unsigned char* data, std::size_t size) {
-    std::string why;
-    if (looks_like_hdr(data, size)) {
-        int w = 0, h = 0;
-        why = check_hdr_data(data, size, w, h);
-        return why.empty() ? why : "cannot decode HDR image: " + why;
-    }
-    why = check_jpeg_data(data, size);
-    return why.empty() ? why : "cannot decode JPEG image: " + why;
+    if (!looks_like_hdr(data, size)) return "";
+    int w = 0, h = 0;
+    const std::string why = check_hdr_data(data, size, w, h);
+    return why.empty() ? why : "cannot decode HDR image: " + why;
 }
 
 // A PNG's IHDR (ISO 15948 11.2.2), when it is the first chunk and its fields
@@ -648,8 +646,84 @@ bool stb_refuses_png_size(const PngHeader& p) {
 struct ImageHeader {
     int width = 0, height = 0, channels = 0;
     bool hdr = false, sixteen_bit = false;
+    bool jpeg = false;         // read by libjpeg-turbo, which decodes it
+    int jpeg_colorspace = -1;  // TJCS_*
     bool png_by_ihdr = false;  // read from the IHDR: stb_image refuses its size, libpng decodes it
 };
+
+// True when the bytes start like a JPEG as stb_image tells one (0xFF, any fill
+// 0xFFs, 0xD8): such data goes to libjpeg-turbo, never to stb_image.
+bool looks_like_jpeg(const unsigned char* data, std::size_t size) {
+    std::size_t i = 0;
+    if (size == 0 || data[0] != 0xFF) return false;
+    while (i < size && data[i] == 0xFF) ++i;
+    return i < size && data[i] == 0xD8;
+}
+
+// A TurboJPEG decompressor, destroyed on every path out.
+struct TjHandle {
+    tjhandle h = tjInitDecompress();
+    ~TjHandle() {
+        if (h) tjDestroy(h);
+    }
+};
+
+// "" with the size, channels (1 grey, else 3: RGB, CMYK and YCCK files become
+// RGB) and colour space of a JPEG filled in; else the decoder's reason.
+std::string read_jpeg_header(const unsigned char* data, std::size_t size, ImageHeader& hd) {
+    TjHandle tj;
+    if (!tj.h) return "cannot start the decoder";
+    if (size > std::size_t(ULONG_MAX)) return "too large";
+    int w = 0, h = 0, subsamp = 0, colorspace = 0;
+    if (tjDecompressHeader3(tj.h, data, static_cast<unsigned long>(size), &w, &h, &subsamp, &colorspace) != 0)
+        return printable(tjGetErrorStr2(tj.h));
+    if (w <= 0 || h <= 0) return "bad image size (" + std::to_string(w) + "x" + std::to_string(h) + ") in the header";
+    hd.width = w;
+    hd.height = h;
+    hd.channels = colorspace == TJCS_GRAY ? 1 : 3;
+    hd.jpeg = true;
+    hd.jpeg_colorspace = colorspace;
+    return "";
+}
+
+// Decodes a JPEG whose header `hd` read, into img's bytes; "" or the reason.
+// The inverse DCT is the accurate integer one (libjpeg's default, as
+// stb_image's was). Progressive files are limited to 500 scans (a file of
+// thousands of tiny scans costs minutes). A warning (corrupt or truncated
+// entropy-coded data) still leaves a whole image, which is kept, as stb_image
+// and browsers keep it.
+std::string decode_jpeg(const unsigned char* data, std::size_t size, const ImageHeader& hd, Image& img) {
+    TjHandle tj;
+    if (!tj.h) return "cannot start the decoder";
+    const bool cmyk = hd.jpeg_colorspace == TJCS_CMYK || hd.jpeg_colorspace == TJCS_YCCK;
+    const int format = hd.channels == 1 ? TJPF_GRAY : cmyk ? TJPF_CMYK : TJPF_RGB;
+    const std::size_t out_channels = cmyk ? 4 : std::size_t(hd.channels);
+    const std::size_t count = std::size_t(hd.width) * std::size_t(hd.height);
+    std::vector<std::uint8_t> px(count * out_channels);
+    if (tjDecompress2(tj.h, data, static_cast<unsigned long>(size), px.data(), hd.width,
+                      int(std::size_t(hd.width) * out_channels), hd.height, format,
+                      TJFLAG_ACCURATEDCT | TJFLAG_LIMITSCANS) != 0 &&
+        tjGetErrorCode(tj.h) != TJERR_WARNING)
+        return printable(tjGetErrorStr2(tj.h));
+    img.width = hd.width;
+    img.height = hd.height;
+    img.channels = hd.channels;
+    if (!cmyk) {
+        img.pixels = std::move(px);
+        return "";
+    }
+    // Adobe's CMYK is stored inverted (255 = no ink): each colour is its
+    // value scaled by K, x * k / 255 rounded.
+    img.pixels.resize(count * 3);
+    for (std::size_t i = 0; i < count; ++i) {
+        const unsigned k = px[i * 4 + 3];
+        for (std::size_t c = 0; c < 3; ++c) {
+            const unsigned t = unsigned(px[i * 4 + c]) * k + 128u;
+            img.pixels[i * 3 + c] = std::uint8_t((t + (t >> 8)) >> 8);
+        }
+    }
+    return "";
+}
 
 // "" with `hd` filled when the bytes (all of a file of `file_size` bytes, or
 // its first ones) have a header that decode_image() goes on to decode; else
@@ -661,7 +735,10 @@ std::string read_image_header(const unsigned char* data, std::size_t size, std::
     const int len = int(std::min<std::size_t>(size, std::size_t(INT_MAX)));
     const char* format = sniff_format(data, size);
     int w = 0, h = 0, comp = 0;
-    if (!stbi_info_from_memory(data, len, &w, &h, &comp)) {
+    if (looks_like_jpeg(data, size)) {
+        const std::string why = read_jpeg_header(data, size, hd);
+        if (!why.empty()) return "cannot decode JPEG image: " + why;
+    } else if (!stbi_info_from_memory(data, len, &w, &h, &comp)) {
         const std::string reason = stbi_reason();
         PngHeader png;
         if (read_png_ihdr(data, size, png) && stb_refuses_png_size(png)) {
@@ -702,13 +779,13 @@ std::string read_image_header(const unsigned char* data, std::size_t size, std::
     if (texels > kMaxImageTexels)
         return "image too large: " + std::to_string(w) + "x" + std::to_string(h) + " = " + std::to_string(texels) +
                " texels, more than the limit of " + std::to_string(kMaxImageTexels) + " (2^28)";
-    if (!hd.png_by_ihdr && (w > kMaxStbImageSide || h > kMaxStbImageSide))
+    if (!hd.png_by_ihdr && !hd.jpeg && (w > kMaxStbImageSide || h > kMaxStbImageSide))
         return std::string("image too large: ") + std::to_string(w) + "x" + std::to_string(h) + ", more than " +
                std::to_string(kMaxStbImageSide) + " pixels a side (" + (format ? format : "this format") +
                " images are decoded by stb_image)";
     // A JPEG needs at least a bit per 8x8 block (a progressive DC scan), so
     // no file holds more than 512 texels a byte; a small file that claims
-    // more would keep stb_image decoding made-up data for seconds.
+    // more would keep the decoder filling made-up data for seconds.
     if (looks_like_jpeg(data, size) && std::uint64_t(texels) > std::uint64_t(kMaxJpegTexelsPerByte) * file_size)
         return "cannot decode JPEG image: " + std::to_string(w) + "x" + std::to_string(h) + " texels from only " +
                std::to_string(file_size) + " bytes (a JPEG holds at most " + std::to_string(kMaxJpegTexelsPerByte) +
@@ -750,8 +827,8 @@ Image decode_image(const ImageSource& src, bool srgb) {
         return img;
     }
 
-    // Through the guards first: stb_image 2.27 can hang on Radiance data and
-    // write out of bounds on JPEG data (scene/hdr_guard.h, scene/jpeg_guard.h).
+    // Through the guard first: stb_image 2.27 can hang on Radiance data
+    // (scene/hdr_guard.h).
     const std::string unsafe = stb_unsafe(data, bytes->size());
     if (!unsafe.empty()) throw LoadError(name + ": " + unsafe);
 
@@ -813,6 +890,10 @@ Image decode_image(const ImageSource& src, bool srgb) {
         const auto decode = [](stbi_us c) { return srgb_to_linear(float(c) / 65535.0f); };
         if (srgb) expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), decode, linear);
         else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
+    } else if (header.jpeg) {
+        const std::string why = decode_jpeg(data, bytes->size(), header, img);
+        if (!why.empty()) throw LoadError(name + ": cannot decode JPEG image: " + why);
+        img.srgb = srgb;
     } else if (is_png(data, bytes->size())) {
         // 8-bit PNG: the bytes as the file has them; sampling decodes them.
         std::string error;
@@ -875,9 +956,8 @@ bool image_dimensions(const ImageSource& src, int& width, int& height, int* byte
         if (bytes_per_texel) *bytes_per_texel = channels;
         return true;
     }
-    // stbi_info reads a JPEG's tables (guarded); a Radiance header alone is
-    // safe, and its pixels are beyond the prefix read here.
-    if (!looks_like_hdr(data, bytes->size()) && !stb_unsafe(data, bytes->size()).empty()) return false;
+    // A Radiance header alone is safe for stbi_info, and its pixels are
+    // beyond the prefix read here: no guard needed.
     // Only a size the decoder goes on to decode: one it refuses is a warning
     // when decoded, never part of the plan.
     ImageHeader header;

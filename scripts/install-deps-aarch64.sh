@@ -41,7 +41,7 @@ fi
 # checks that every file it names exists. libedit and what it links (tinfo,
 # libbsd, libmd) for step's prompt: configuring needs them even when only
 # render is built.
-ARM64_PACKAGES="zlib1g-dev libpng-dev libwebp-dev libdeflate-dev libdraco-dev libdraco7
+ARM64_PACKAGES="zlib1g-dev libpng-dev libwebp-dev libdeflate-dev libturbojpeg0-dev libdraco-dev libdraco7
   libedit-dev libncurses-dev libbsd-dev libmd-dev"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

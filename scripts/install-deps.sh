@@ -1,7 +1,7 @@
 #!/bin/sh
 # Installs the Debian 12 packages prast builds with (compiler, CMake, the
-# header-only libraries, and zlib, libpng, libdeflate, libwebp and libdraco,
-# linked statically; libmeshoptimizer only for the tests, which encode with
+# header-only libraries, and zlib, libpng, libdeflate, libturbojpeg, libwebp
+# and libdraco, linked statically; libmeshoptimizer only for the tests, which encode with
 # it; pybind11, the Python headers and numpy for the Python module, pytest
 # for its tests), those not installed yet (scripts/install-packages.sh: apt-get
 # through sudo unless already root).
@@ -23,6 +23,7 @@ PACKAGES="
   libdraco-dev
   libwebp-dev
   libdeflate-dev
+  libturbojpeg0-dev
   libmeshoptimizer-dev
   pybind11-dev
   python3-dev

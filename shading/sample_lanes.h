@@ -3,14 +3,16 @@
 // into texel indices and filter weights (branch-free loops over lanes, which
 // the compiler vectorises), and fetch_trilinear_lanes() reads and blends the
 // texels. 8-bit textures are read 8 (or 4) lanes per instruction: an AVX2
-// gather of each tap's packed texel bytes, the channels unpacked and turned
-// into floats (a gather from the sRGB table, or a division by 255), then the
-// bilinear and trilinear blends across lanes. Float textures are read one live
-// lane at a time (one 4-channel vector per texel). Every lane performs exactly
-// the float operations of Texture::sample_lod() (the texture's filters;
-// sample_trilinear() for the default ones) in the same order, so
-// the two agree bit for bit (tests/test_sample_lanes.cpp); the stepper and the
-// debug views keep using the scalar sampler.
+// gather of each tap's packed texel bytes, the channels unpacked into their
+// 15-bit codes (a shift, or a gather from the sRGB code table), then the
+// fixed-point lerps of texture.h, each one multiply-add of 16-bit pairs
+// (_mm256_madd_epi16); sparse blocks and builds without AVX2 call the scalar
+// sampler's own steps (Texture::fix_bilinear, fix_blend) lane by lane.
+// Integers agree wherever they are computed. Float textures are read one live
+// lane at a time (one 4-channel vector per texel), with exactly the float
+// operations of Texture::sample_lod() in the same order. So every lane equals
+// the scalar sampler bit for bit (tests/test_sample_lanes.cpp); the stepper
+// and the debug views keep using the scalar sampler.
 //
 // The indices depend only on the level-0 size and the sampler, as does
 // lambda (Texture::lod), so textures with the same layout share one
@@ -164,13 +166,6 @@ inline Float4 load_texel(const glm::vec4* texels, std::int32_t i) {
     return r;
 }
 
-// Any storage (the non-AVX2 builds' path for 8-bit textures).
-inline Float4 load_texel(const Texture* tex, std::int32_t i) {
-    if (!tex->is_unorm8()) return load_texel(tex->texel_data(), i);
-    const glm::vec4 t = tex->texel_at(std::size_t(i));
-    return Float4{t.r, t.g, t.b, t.a};
-}
-
 template <class Texels>
 [[gnu::always_inline]] inline Float4 bilinear(const Texels& texels, const std::int32_t (*idx)[kMaxN], const float* tx,
                                               const float* ty, int l) {
@@ -181,8 +176,36 @@ template <class Texels>
     return top + (bottom - top) * ty[l];
 }
 
-// The live lanes one at a time, for K textures: src[k] is a float texture's
-// texel array, or the Texture itself (any storage).
+// Lane l of an 8-bit texture: Texture::trilinear_wrapped() / filtered_wrapped()'s
+// fixed-point steps on the prepared indices and weights.
+[[gnu::always_inline]] inline glm::vec4 fix_lane(const Texture& tex, const TrilinearLanes& at, int l) {
+    const bool nearest = (at.nearest >> l) & 1u;
+    auto level = [&](const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty) {
+        if (nearest) return tex.fix_texel(std::size_t(idx[0][l]));
+        return tex.fix_bilinear(std::size_t(idx[0][l]), std::size_t(idx[1][l]), std::size_t(idx[2][l]),
+                                std::size_t(idx[3][l]), tx[l], ty[l]);
+    };
+    Texture::Fix4 a = level(at.ia, at.txa, at.tya);
+    if ((at.blend >> l) & 1u) a = Texture::fix_blend(a, level(at.ib, at.txb, at.tyb), at.t[l]);
+    return tex.fix_value(a);
+}
+
+// The live lanes of an 8-bit texture one at a time; the others get 0.
+template <int N>
+inline void fetch_fix_one_by_one(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
+    if (at.live != (1u << N) - 1u)
+        for (int l = 0; l < N; ++l) out.r[l] = out.g[l] = out.b[l] = out.a[l] = 0.0f;
+    for (std::uint32_t m = at.live; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        const glm::vec4 c = fix_lane(tex, at, l);
+        out.r[l] = c.r;
+        out.g[l] = c.g;
+        out.b[l] = c.b;
+        out.a[l] = c.a;
+    }
+}
+
+// The live lanes one at a time, for K float textures: src[k] is a texel array.
 template <int N, int K, class Texels>
 inline void fetch_lanes_one_by_one(const Texels* const* src, const TrilinearLanes& at, TexelLanes* const* out) {
     if (at.live != (1u << N) - 1u) {
@@ -226,8 +249,15 @@ inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLan
         const glm::vec4* texels[K];
         for (int k = 0; k < K; ++k) texels[k] = tex[k]->texel_data();
         fetch_lanes_one_by_one<N, K, glm::vec4>(texels, at, out);
-    } else {
-        fetch_lanes_one_by_one<N, K, Texture>(tex, at, out);
+        return;
+    }
+    for (int k = 0; k < K; ++k) {
+        if (tex[k]->is_unorm8()) {
+            fetch_fix_one_by_one<N>(*tex[k], at, *out[k]);
+        } else {
+            const glm::vec4* texels = tex[k]->texel_data();
+            fetch_lanes_one_by_one<N, 1, glm::vec4>(&texels, at, out + k);
+        }
     }
 }
 
@@ -265,19 +295,39 @@ inline void gather_texel_pairs(const std::uint8_t* base, typename V::I idx, type
     }
 }
 
-// Stored channel c of the words as floats, through its table.
+// Stored channel c of the words as 15-bit codes (texture.h): byte * 128, or
+// the sRGB code table's entry (a 4-byte gather at 2 bytes an entry; the
+// table has spare entries).
 template <class V>
-inline typename V::F decode_channel(typename V::I words, int c, const float* table, bool divide) {
+inline typename V::I channel_codes(typename V::I words, int c, const std::uint16_t* srgb_codes) {
     const typename V::I byte = V::and_i(V::srlv_i(words, V::set1_i(8 * c)), V::set1_i(0xFF));
-    if (divide) return V::div(V::cvt(byte), V::set1_f(255.0f));  // == unorm8_decode_table()[byte]
-    return V::gather_f(table, byte);
+    if (!srgb_codes) return V::template slli_i<7>(byte);
+    return V::and_i(V::template gather_i<2>(reinterpret_cast<const std::uint8_t*>(srgb_codes), byte),
+                    V::set1_i(0xFFFF));
 }
 
-// Bilinear filter of every stored channel of one level for lanes [l0, l0 + W).
+// texture_detail::weight8 / lerp8 / narrow8, per lane. A lerp is one
+// multiply-add of the 16-bit pairs (a, b) and (256 - w, w): the codes are at
+// most 32640 and the weights 256, inside madd's signed 16-bit inputs.
+template <class V> inline typename V::I weight8(typename V::F t) {
+    return V::cvtt(V::add(V::mul(t, V::set1_f(256.0f)), V::set1_f(0.5f)));
+}
+template <class V> inline typename V::I weight_pairs(typename V::I w) {
+    return V::or_i(V::sub_i(V::set1_i(256), w), V::template slli_i<16>(w));
+}
+template <class V> inline typename V::I lerp8(typename V::I a, typename V::I b, typename V::I pairs) {
+    return V::madd_i(V::or_i(a, V::template slli_i<16>(b)), pairs);
+}
+template <class V> inline typename V::I narrow8(typename V::I x) {
+    return V::template srli_i<8>(V::add_i(x, V::set1_i(128)));
+}
+
+// Bilinear filter of every needed stored channel of one level for lanes
+// [l0, l0 + W): Texture::fix_bilinear() per lane.
 template <class V, int C>
-[[gnu::always_inline]] inline void bilinear_unorm8(const Texture& tex, const bool* divide, unsigned need, const std::int32_t (*idx)[kMaxN],
-                            const float* tx_lanes, const float* ty_lanes, int l0, typename V::F* result) {
-    using F = typename V::F;
+[[gnu::always_inline]] inline void bilinear_unorm8(const Texture& tex, const std::uint16_t* const* srgb_codes, unsigned need,
+                                                   const std::int32_t (*idx)[kMaxN], const float* tx_lanes,
+                                                   const float* ty_lanes, int l0, typename V::I* result) {
     using I = typename V::I;
     const std::uint8_t* base = tex.unorm8_data();
     const I ia = V::load_i(idx[0] + l0), ib = V::load_i(idx[1] + l0);
@@ -295,16 +345,16 @@ template <class V, int C>
         wc = gather_texels<V, C>(base, ic);
         wd = gather_texels<V, C>(base, id);
     }
-    const F tx = V::load_f(tx_lanes + l0), ty = V::load_f(ty_lanes + l0);
+    const I wx = weight_pairs<V>(weight8<V>(V::load_f(tx_lanes + l0)));
+    const I wy = weight_pairs<V>(weight8<V>(V::load_f(ty_lanes + l0)));
     for (int c = 0; c < C; ++c) {
         if (!((need >> c) & 1u)) continue;
-        const float* table = tex.table(c);
-        const F a = decode_channel<V>(wa, c, table, divide[c]), b = decode_channel<V>(wb, c, table, divide[c]);
-        const F cc = decode_channel<V>(wc, c, table, divide[c]), d = decode_channel<V>(wd, c, table, divide[c]);
-        // top = a + (b - a) tx; bottom = c + (d - c) tx; top + (bottom - top) ty.
-        const F top = V::add(a, V::mul(V::sub(b, a), tx));
-        const F bottom = V::add(cc, V::mul(V::sub(d, cc), tx));
-        result[c] = V::add(top, V::mul(V::sub(bottom, top), ty));
+        const std::uint16_t* codes = srgb_codes[c];
+        const I a = channel_codes<V>(wa, c, codes), b = channel_codes<V>(wb, c, codes);
+        const I cc = channel_codes<V>(wc, c, codes), d = channel_codes<V>(wd, c, codes);
+        const I top = narrow8<V>(lerp8<V>(a, b, wx));
+        const I bottom = narrow8<V>(lerp8<V>(cc, d, wx));
+        result[c] = lerp8<V>(top, bottom, wy);
     }
 }
 
@@ -315,8 +365,9 @@ template <int N, int W, int C>
 inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
     using V = Simd<W>;
     using F = typename V::F;
-    bool divide[4];
-    for (int c = 0; c < C; ++c) divide[c] = tex.table(c) == unorm8_decode_table();
+    using I = typename V::I;
+    const std::uint16_t* srgb_codes[4] = {nullptr, nullptr, nullptr, nullptr};
+    for (int c = 0; c < C; ++c) srgb_codes[c] = tex.srgb(c) ? tex.code_table(c) : nullptr;
     float* dst[4] = {out.r, out.g, out.b, out.a};
     unsigned need = 0;
     for (int k = 0; k < 4; ++k)
@@ -328,70 +379,31 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
                 if ((components >> k) & 1u) V::store_f(dst[k] + l0, V::zero_f());
             continue;
         }
-        F res[4] = {V::zero_f(), V::zero_f(), V::zero_f(), V::zero_f()};
-        bilinear_unorm8<V, C>(tex, divide, need, at.ia, at.txa, at.tya, l0, res);
+        const I izero = V::set1_i(0);
+        I res[4] = {izero, izero, izero, izero};
+        bilinear_unorm8<V, C>(tex, srgb_codes, need, at.ia, at.txa, at.tya, l0, res);
         const unsigned blend = (at.blend >> l0) & ((1u << W) - 1u);
         if (blend) {
-            F resb[4] = {V::zero_f(), V::zero_f(), V::zero_f(), V::zero_f()};
-            bilinear_unorm8<V, C>(tex, divide, need, at.ib, at.txb, at.tyb, l0, resb);
-            const F t = V::load_f(at.t + l0);
-            const F mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits()));
+            I resb[4] = {izero, izero, izero, izero};
+            bilinear_unorm8<V, C>(tex, srgb_codes, need, at.ib, at.txb, at.tyb, l0, resb);
+            const I wt = weight_pairs<V>(weight8<V>(V::load_f(at.t + l0)));
+            const I mask = V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits());
             for (int c = 0; c < C; ++c)
-                if ((need >> c) & 1u) res[c] = V::select(mask, V::add(res[c], V::mul(V::sub(resb[c], res[c]), t)), res[c]);
+                if ((need >> c) & 1u)
+                    res[c] = V::select_i(mask, lerp8<V>(narrow8<V>(res[c]), narrow8<V>(resb[c]), wt), res[c]);
         }
         const F live_mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(live)), V::lane_bits()), V::lane_bits()));
         const F zero = V::zero_f();
+        const F full = V::set1_f(texture_detail::kFixFullF);
+        F value[4] = {zero, zero, zero, zero};
+        for (int c = 0; c < C; ++c)
+            if ((need >> c) & 1u) value[c] = V::div(V::cvt(res[c]), full);  // Texture::fix_value()
         for (int k = 0; k < 4; ++k) {
             if (!((components >> k) & 1u)) continue;
             const int sw = tex.swizzle(k);
-            const F v = sw == Texture::kOne ? V::set1_f(1.0f) : res[sw];
+            const F v = sw == Texture::kOne ? V::set1_f(1.0f) : value[sw];
             V::store_f(dst[k] + l0, V::select(live_mask, v, zero));
         }
-    }
-}
-
-// The stored channels of one 8-bit texel (index i) as a vector, through
-// their tables; channels past C are 0 (never written out).
-template <int C>
-[[gnu::always_inline]] inline Float4 load_unorm8_texel(const std::uint8_t* base, const float* const* table, std::int32_t i) {
-    const std::uint8_t* p = base + std::size_t(i) * C;
-    Float4 r = {0.0f, 0.0f, 0.0f, 0.0f};
-    r[0] = table[0][p[0]];
-    if constexpr (C > 1) r[1] = table[1][p[1]];
-    if constexpr (C > 2) r[2] = table[2][p[2]];
-    if constexpr (C > 3) r[3] = table[3][p[3]];
-    return r;
-}
-
-template <int C>
-[[gnu::always_inline]] inline Float4 bilinear_unorm8_lane(const std::uint8_t* base, const float* const* table,
-                                   const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty, int l) {
-    const Float4 a = load_unorm8_texel<C>(base, table, idx[0][l]), b = load_unorm8_texel<C>(base, table, idx[1][l]);
-    const Float4 c = load_unorm8_texel<C>(base, table, idx[2][l]), d = load_unorm8_texel<C>(base, table, idx[3][l]);
-    const Float4 top = a + (b - a) * tx[l];
-    const Float4 bottom = c + (d - c) * tx[l];
-    return top + (bottom - top) * ty[l];
-}
-
-// The live lanes of an 8-bit texture one at a time (sparse blocks: the
-// gathers would fetch the dead lanes too). The same operations per channel.
-template <int N, int C>
-inline void fetch_unorm8_one_by_one(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
-    const float* table[4] = {tex.table(0), tex.table(C > 1 ? 1 : 0), tex.table(C > 2 ? 2 : 0), tex.table(C > 3 ? 3 : 0)};
-    const std::uint8_t* base = tex.unorm8_data();
-    float* dst[4] = {out.r, out.g, out.b, out.a};
-    int sw[4];
-    for (int k = 0; k < 4; ++k) sw[k] = tex.swizzle(k);
-    if (at.live != (1u << N) - 1u)
-        for (int l = 0; l < N; ++l) out.r[l] = out.g[l] = out.b[l] = out.a[l] = 0.0f;
-    for (std::uint32_t m = at.live; m; m &= m - 1) {
-        const int l = __builtin_ctz(m);
-        Float4 c = bilinear_unorm8_lane<C>(base, table, at.ia, at.txa, at.tya, l);
-        if ((at.blend >> l) & 1u) {
-            const Float4 cb = bilinear_unorm8_lane<C>(base, table, at.ib, at.txb, at.tyb, l);
-            c = c + (cb - c) * at.t[l];
-        }
-        for (int k = 0; k < 4; ++k) dst[k][l] = sw[k] == Texture::kOne ? 1.0f : c[sw[k] & 3];
     }
 }
 
@@ -403,10 +415,10 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
     constexpr int W = N >= 8 ? 8 : 4;
     const bool sparse = __builtin_popcount(at.live) <= kSparseLanes;
     switch (tex.channels()) {
-    case 1: sparse ? fetch_unorm8_one_by_one<N, 1>(tex, at, out) : fetch_unorm8_lanes<N, W, 1>(tex, at, out, components); return;
-    case 2: sparse ? fetch_unorm8_one_by_one<N, 2>(tex, at, out) : fetch_unorm8_lanes<N, W, 2>(tex, at, out, components); return;
-    case 3: sparse ? fetch_unorm8_one_by_one<N, 3>(tex, at, out) : fetch_unorm8_lanes<N, W, 3>(tex, at, out, components); return;
-    default: sparse ? fetch_unorm8_one_by_one<N, 4>(tex, at, out) : fetch_unorm8_lanes<N, W, 4>(tex, at, out, components); return;
+    case 1: sparse ? fetch_fix_one_by_one<N>(tex, at, out) : fetch_unorm8_lanes<N, W, 1>(tex, at, out, components); return;
+    case 2: sparse ? fetch_fix_one_by_one<N>(tex, at, out) : fetch_unorm8_lanes<N, W, 2>(tex, at, out, components); return;
+    case 3: sparse ? fetch_fix_one_by_one<N>(tex, at, out) : fetch_unorm8_lanes<N, W, 3>(tex, at, out, components); return;
+    default: sparse ? fetch_fix_one_by_one<N>(tex, at, out) : fetch_unorm8_lanes<N, W, 4>(tex, at, out, components); return;
     }
 }
 

@@ -41,7 +41,15 @@ template <> struct Simd<8> {
         shifted = pick_low(_mm256_srli_epi64(a, Shift), _mm256_srli_epi64(b, Shift));
     }
     static I add_i(I a, I b) { return _mm256_add_epi32(a, b); }
+    static I sub_i(I a, I b) { return _mm256_sub_epi32(a, b); }
     static I and_i(I a, I b) { return _mm256_and_si256(a, b); }
+    static I or_i(I a, I b) { return _mm256_or_si256(a, b); }
+    template <int N> static I slli_i(I a) { return _mm256_slli_epi32(a, N); }
+    template <int N> static I srli_i(I a) { return _mm256_srli_epi32(a, N); }
+    // Per 32-bit lane: low16(a) low16(b) + high16(a) high16(b), signed.
+    static I madd_i(I a, I b) { return _mm256_madd_epi16(a, b); }
+    static I cvtt(F a) { return _mm256_cvttps_epi32(a); }
+    static I select_i(I mask, I yes, I no) { return _mm256_blendv_epi8(no, yes, mask); }
     static I srlv_i(I a, I n) { return _mm256_srlv_epi32(a, n); }
     static I cmpeq_i(I a, I b) { return _mm256_cmpeq_epi32(a, b); }
     static F cvt(I a) { return _mm256_cvtepi32_ps(a); }
@@ -86,7 +94,14 @@ template <> struct Simd<4> {
         shifted = pick_low(_mm256_srli_epi64(q, Shift));
     }
     static I add_i(I a, I b) { return _mm_add_epi32(a, b); }
+    static I sub_i(I a, I b) { return _mm_sub_epi32(a, b); }
     static I and_i(I a, I b) { return _mm_and_si128(a, b); }
+    static I or_i(I a, I b) { return _mm_or_si128(a, b); }
+    template <int N> static I slli_i(I a) { return _mm_slli_epi32(a, N); }
+    template <int N> static I srli_i(I a) { return _mm_srli_epi32(a, N); }
+    static I madd_i(I a, I b) { return _mm_madd_epi16(a, b); }
+    static I cvtt(F a) { return _mm_cvttps_epi32(a); }
+    static I select_i(I mask, I yes, I no) { return _mm_blendv_epi8(no, yes, mask); }
     static I srlv_i(I a, I n) { return _mm_srlv_epi32(a, n); }
     static I cmpeq_i(I a, I b) { return _mm_cmpeq_epi32(a, b); }
     static F cvt(I a) { return _mm_cvtepi32_ps(a); }

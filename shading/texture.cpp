@@ -261,7 +261,44 @@ std::uint8_t* allocate_texels(std::size_t bytes) {
     return static_cast<std::uint8_t*>(p);
 }
 
+// The 15-bit codes of the fixed-point filter (texture.h): linear bytes b * 128;
+// sRGB bytes the exact decode (in double) * 32640, rounded to nearest. Two
+// spare entries, so that a 4-byte read at any entry stays inside (the block
+// sampler's gathers).
+struct CodeTables {
+    alignas(64) std::uint16_t linear[258];
+    alignas(64) std::uint16_t srgb[258];
+    alignas(64) float srgb_value[256];  // srgb[b] / 32640
+
+    CodeTables() {
+        for (int b = 0; b < 256; ++b) {
+            const double c = double(b) / 255.0;
+            const double lin = c <= 0.04045 ? c / 12.92 : det::pow((c + 0.055) / 1.055, 2.4);
+            linear[b] = std::uint16_t(b * 128);
+            srgb[b] = std::uint16_t(std::floor(lin * double(texture_detail::kFixOne) + 0.5));
+            srgb_value[b] = float(srgb[b]) / float(texture_detail::kFixOne);
+        }
+        linear[256] = linear[257] = srgb[256] = srgb[257] = 0;
+    }
+};
+
+const CodeTables& code_tables() {
+    static const CodeTables t;
+    return t;
+}
+
 } // namespace
+
+namespace texture_detail {
+namespace {
+std::array<float, 257> make_log2_mantissa() {
+    std::array<float, 257> t{};
+    for (int i = 0; i <= 256; ++i) t[std::size_t(i)] = float(det::log2(1.0 + double(i) / 256.0));
+    return t;
+}
+} // namespace
+const std::array<float, 257> kLog2Mantissa = make_log2_mantissa();
+} // namespace texture_detail
 
 // The samplers for each (wrap_s, wrap_t), indexed by the Wrap enumerators.
 static_assert(int(Wrap::Repeat) == 0 && int(Wrap::ClampToEdge) == 1 && int(Wrap::MirroredRepeat) == 2);
@@ -386,10 +423,14 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const flo
     tex.set_sampler(SamplerState{s, t});
     tex.channels_ = channels;
     bool srgb_channel[4] = {false, false, false, false};
+    const CodeTables& codes = code_tables();
     for (int c = 0; c < 4; ++c) {
-        tex.table_[c] = tables[c];
         tex.swizzle_[c] = swizzle[c];
         srgb_channel[c] = c < channels && tables[c] == srgb8_decode_table();
+        tex.srgb_[c] = srgb_channel[c];
+        // Linear: b * 128 / 32640 is b / 255, which unorm8_decode_table() holds.
+        tex.code_[c] = srgb_channel[c] ? codes.srgb : codes.linear;
+        tex.table_[c] = srgb_channel[c] ? codes.srgb_value : unorm8_decode_table();
     }
     tex.layout(w, h);
     const std::size_t C = std::size_t(channels);

@@ -4,18 +4,29 @@
 // Conventions (docs/conventions.md, "Textures"): texel centres at (i + 0.5) / width,
 // v = 0 is the TOP row of the image (the project's internal UVs; no flipping
 // here), lambda = log2(max(|d(uv * size)/dx|, |d(uv * size)/dy|)) with level-0
-// sizes, as the OpenGL specification writes it (no anisotropy). Filtering and
-// mip generation happen in linear space.
+// sizes, as the OpenGL specification writes it (no anisotropy), the log2 from
+// a table (texture_detail::lod_log2). Filtering and mip generation happen in
+// linear space.
 //
 // Storage follows the image: 8-bit images keep 1 to 4 bytes per texel (a
-// 2048x2048 RGBA map with its mips is 21.3 MB, not the 89 MB of float RGBA),
-// decoded to float per texel when sampled through 256-entry tables (sRGB for
-// the colour channels of colour maps), so level 0 samples exactly the floats a
-// float texture of the decoded image would. Their mips are stored in 8 bits
-// too, as GPUs store generated mips: each texel is the correctly rounded byte
-// of the exact area-weighted box filter of the level above, in linear space
-// (sRGB channels are decoded, filtered, and re-encoded). Float images (HDR,
-// 16-bit, procedural) keep float RGBA texels and float mips.
+// 2048x2048 RGBA map with its mips is 21.3 MB, not the 89 MB of float RGBA).
+// Their mips are stored in 8 bits too, as GPUs store generated mips: each
+// texel is the correctly rounded byte of the exact area-weighted box filter of
+// the level above, in linear space (sRGB channels are decoded, filtered, and
+// re-encoded). Float images (HDR, 16-bit, procedural) keep float RGBA texels
+// and float mips, and filter in float.
+//
+// 8-bit textures filter in fixed point (docs/conventions.md, "Precision of
+// the weights"), as llvmpipe's 8-bit path and Direct3D 11 hardware do: each
+// stored byte becomes a 15-bit linear code (byte * 128 for linear channels,
+// the correctly rounded sRGB decode * 32640 for colour ones: linear 1.0 is
+// 32640 = 255 * 128), the bilinear and level weights are rounded to 8 bits
+// (w = int(t * 256 + 0.5), 0..256), and each lerp is a * (256 - w) + b * w
+// in integers, narrowed back to 15 bits ((x + 128) >> 8) before the next
+// one. The last integer (at most 32640 * 256) becomes a float by one
+// division by 32640 * 256. Integers leave nothing to round differently, so
+// the scalar sampler, the 4x4-block one and the stepper agree by
+// construction; a linear byte b that is read alone gives exactly b / 255.
 //
 // A Texture is the decoded storage (shared, immutable) seen through one
 // sampler: its wrap modes and its glTF/OpenGL filters. with_sampler() gives
@@ -35,10 +46,12 @@
 // render threads: no caches, no allocation and no virtual calls when sampling.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -130,15 +143,35 @@ public:
 
     // Storage. Float: texel_data() holds float RGBA. 8-bit: unorm8_data() holds
     // channels() bytes per texel (and kReadSlack more bytes, so that 8 bytes can
-    // be read at any texel); stored channel c becomes a float through table(c), and
-    // output component k (r, g, b, a) is stored channel swizzle(k), or 1 when
-    // swizzle(k) == kOne.
+    // be read at any texel); stored channel c's byte becomes the 15-bit code
+    // code_table(c)[byte] (file comment), whose value table(c)[byte] is
+    // code / 32640; output component k (r, g, b, a) is stored channel
+    // swizzle(k), or 1 when swizzle(k) == kOne.
     static constexpr int kOne = 4;
     static constexpr std::size_t kReadSlack = 8;
     bool is_unorm8() const { return channels_ > 0; }
     int channels() const { return channels_; }
     int swizzle(int k) const { return swizzle_[k]; }
     const float* table(int c) const { return table_[c]; }
+    const std::uint16_t* code_table(int c) const { return code_[c]; }
+    // Stored channel c holds sRGB-encoded bytes.
+    bool srgb(int c) const { return srgb_[c]; }
+
+    // The 8-bit filter's steps (file comment), shared by the scalar sampler
+    // and the block sampler's lanes: per stored channel, an integer in
+    // [0, 32640 * 256].
+    struct Fix4 {
+        std::int32_t c[4] = {0, 0, 0, 0};
+    };
+    // Texel i alone (NEAREST): code * 256.
+    Fix4 fix_texel(std::size_t i) const;
+    // Bilinear over texels i00, i10 (right), i01 (below), i11 with weights tx, ty.
+    Fix4 fix_bilinear(std::size_t i00, std::size_t i10, std::size_t i01, std::size_t i11, float tx,
+                      float ty) const;
+    // Level blend a + (b - a) t, both narrowed to codes first.
+    static Fix4 fix_blend(const Fix4& a, const Fix4& b, float t);
+    // As linear RGBA: each channel / (32640 * 256), through swizzle().
+    glm::vec4 fix_value(const Fix4& f) const;
     // The texels of every level, level 0 first, each row-major; level k starts
     // at texel level_offset(k). For the 4x4-block sampler (sample_lanes.h).
     const glm::vec4* texel_data() const { return texels_; }
@@ -183,6 +216,10 @@ private:
     }
     // The samplers with the wrap modes fixed at compile time; the public ones
     // dispatch to them through a table, once per call.
+    template <Wrap S, Wrap T>
+    void footprint(float u, float v, int level, std::size_t idx[4], float& tx, float& ty) const;
+    template <Wrap S, Wrap T> Fix4 fix_bilinear_reduced(float u, float v, int level) const;
+    template <Wrap S, Wrap T> std::size_t nearest_texel(float u, float v, int level) const;
     template <Wrap S, Wrap T> glm::vec4 bilinear_reduced(float u, float v, int level) const;
     template <Wrap S, Wrap T> glm::vec4 bilinear_wrapped(float u, float v, int level) const;
     template <Wrap S, Wrap T> glm::vec4 trilinear_wrapped(float u, float v, float lambda) const;
@@ -216,6 +253,8 @@ private:
     int channels_ = 0;               // 0: float storage
     int swizzle_[4] = {0, 1, 2, 3};
     const float* table_[4] = {nullptr, nullptr, nullptr, nullptr};
+    const std::uint16_t* code_[4] = {nullptr, nullptr, nullptr, nullptr};
+    bool srgb_[4] = {false, false, false, false};
     std::size_t total_texels_ = 0;
     std::size_t memory_bytes_ = 0;
     Level levels_[kMaxLevels];
@@ -276,15 +315,46 @@ inline int wrap_index(int i, int n) {
     return i >= n ? n - 1 : i;
 }
 
+// The fixed-point filter of 8-bit textures (file comment).
+constexpr std::int32_t kFixOne = 255 * 128;         // the code of linear 1.0
+constexpr std::int32_t kFixFull = kFixOne * 256;    // a filtered value before narrowing
+constexpr float kFixFullF = float(kFixFull);        // exact
+
+// A weight in [0, 1] rounded to 8 bits: 0..256 (t * 256 is exact).
+inline std::int32_t weight8(float t) { return std::int32_t(t * 256.0f + 0.5f); }
+// a (256 - w) + b w, for codes a, b <= kFixOne: at most kFixFull.
+inline std::int32_t lerp8(std::int32_t a, std::int32_t b, std::int32_t w) { return a * (256 - w) + b * w; }
+// A lerp's result back to a code, rounding half up.
+inline std::int32_t narrow8(std::int32_t x) { return (x + 128) >> 8; }
+
+// log2(x) for the level of detail, the same bits everywhere and cheap
+// enough per quad: the exponent, plus log2(1 + m) for the mantissa m read
+// linearly between the 257 entries of a table of log2(1 + i / 256) made with
+// det::log2 (error below 3e-6 before the sum's rounding, far under the 1/256
+// the level fraction keeps).
+// x must be a positive normal float.
+extern const std::array<float, 257> kLog2Mantissa;
+inline float lod_log2(float x) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    const int e = int(bits >> 23) - 127;
+    const std::uint32_t m = bits & 0x7FFFFFu;
+    const int i = int(m >> 15);
+    const float f = float(m & 0x7FFFu) * (1.0f / 32768.0f);  // exact
+    const float lo = kLog2Mantissa[std::size_t(i)], hi = kLog2Mantissa[std::size_t(i) + 1];
+    return float(e) + (lo + (hi - lo) * f);
+}
+
 } // namespace texture_detail
 
 template <Wrap S, Wrap T>
-inline glm::vec4 Texture::bilinear_reduced(float u, float v, int level) const {
+inline void Texture::footprint(float u, float v, int level, std::size_t idx[4], float& tx, float& ty) const {
     const Level& L = levels_[level];
     // Texel centres at (i + 0.5) / size.
     const float x = u * L.fwidth - 0.5f, y = v * L.fheight - 0.5f;
     const float fx = std::floor(x), fy = std::floor(y);
-    const float tx = x - fx, ty = y - fy;
+    tx = x - fx;
+    ty = y - fy;
     const int x0 = int(fx), y0 = int(fy);
     const int xa = texture_detail::wrap_index<S>(x0, L.width);
     const int xb = texture_detail::wrap_index<S>(x0 + 1, L.width);
@@ -292,13 +362,70 @@ inline glm::vec4 Texture::bilinear_reduced(float u, float v, int level) const {
     const int yb = texture_detail::wrap_index<T>(y0 + 1, L.height);
     const std::size_t row_a = L.offset + std::size_t(ya) * std::size_t(L.width);
     const std::size_t row_b = L.offset + std::size_t(yb) * std::size_t(L.width);
-    const glm::vec4 a = texel_at(row_a + std::size_t(xa)), b = texel_at(row_a + std::size_t(xb));
-    const glm::vec4 c = texel_at(row_b + std::size_t(xa)), d = texel_at(row_b + std::size_t(xb));
+    idx[0] = row_a + std::size_t(xa);
+    idx[1] = row_a + std::size_t(xb);
+    idx[2] = row_b + std::size_t(xa);
+    idx[3] = row_b + std::size_t(xb);
+}
+
+template <Wrap S, Wrap T>
+inline Texture::Fix4 Texture::fix_bilinear_reduced(float u, float v, int level) const {
+    std::size_t i[4];
+    float tx, ty;
+    footprint<S, T>(u, v, level, i, tx, ty);
+    return fix_bilinear(i[0], i[1], i[2], i[3], tx, ty);
+}
+
+template <Wrap S, Wrap T>
+inline glm::vec4 Texture::bilinear_reduced(float u, float v, int level) const {
+    if (channels_) return fix_value(fix_bilinear_reduced<S, T>(u, v, level));
+    std::size_t i[4];
+    float tx, ty;
+    footprint<S, T>(u, v, level, i, tx, ty);
+    const glm::vec4 a = texels_[i[0]], b = texels_[i[1]], c = texels_[i[2]], d = texels_[i[3]];
     // a + (b - a) t: exact at t = 0 and wherever a == b (a constant texture
     // samples to exactly its value).
     const glm::vec4 top = a + (b - a) * tx;
     const glm::vec4 bottom = c + (d - c) * tx;
     return top + (bottom - top) * ty;
+}
+
+inline Texture::Fix4 Texture::fix_texel(std::size_t i) const {
+    const std::uint8_t* p = bytes_ + i * std::size_t(channels_);
+    Fix4 r;
+    for (int c = 0; c < channels_; ++c) r.c[c] = std::int32_t(code_[c][p[c]]) * 256;
+    return r;
+}
+
+inline Texture::Fix4 Texture::fix_bilinear(std::size_t i00, std::size_t i10, std::size_t i01, std::size_t i11,
+                                           float tx, float ty) const {
+    using namespace texture_detail;
+    const std::size_t C = std::size_t(channels_);
+    const std::uint8_t *a = bytes_ + i00 * C, *b = bytes_ + i10 * C, *c = bytes_ + i01 * C, *d = bytes_ + i11 * C;
+    const std::int32_t wx = weight8(tx), wy = weight8(ty);
+    Fix4 r;
+    for (std::size_t k = 0; k < C; ++k) {
+        const std::uint16_t* code = code_[k];
+        const std::int32_t top = narrow8(lerp8(code[a[k]], code[b[k]], wx));
+        const std::int32_t bottom = narrow8(lerp8(code[c[k]], code[d[k]], wx));
+        r.c[k] = lerp8(top, bottom, wy);
+    }
+    return r;
+}
+
+inline Texture::Fix4 Texture::fix_blend(const Fix4& a, const Fix4& b, float t) {
+    using namespace texture_detail;
+    const std::int32_t w = weight8(t);
+    Fix4 r;
+    for (int k = 0; k < 4; ++k) r.c[k] = lerp8(narrow8(a.c[k]), narrow8(b.c[k]), w);
+    return r;
+}
+
+inline glm::vec4 Texture::fix_value(const Fix4& f) const {
+    float v[5];
+    for (int k = 0; k < 4; ++k) v[k] = float(f.c[k]) / texture_detail::kFixFullF;
+    v[kOne] = 1.0f;
+    return {v[swizzle_[0]], v[swizzle_[1]], v[swizzle_[2]], v[swizzle_[3]]};
 }
 
 template <Wrap S, Wrap T>
@@ -316,17 +443,27 @@ inline glm::vec4 Texture::trilinear_wrapped(float u, float v, float lambda) cons
     const float fl = std::floor(lambda);  // in [0, last): the int conversion is safe
     const int l0 = int(fl);
     const float t = lambda - fl;
+    if (channels_) {
+        const Fix4 a = fix_bilinear_reduced<S, T>(ur, vr, l0);
+        if (t == 0.0f) return fix_value(a);
+        return fix_value(fix_blend(a, fix_bilinear_reduced<S, T>(ur, vr, l0 + 1), t));
+    }
     const glm::vec4 a = bilinear_reduced<S, T>(ur, vr, l0);
     if (t == 0.0f) return a;
     return a + (bilinear_reduced<S, T>(ur, vr, l0 + 1) - a) * t;
 }
 
 template <Wrap S, Wrap T>
-inline glm::vec4 Texture::nearest_reduced(float u, float v, int level) const {
+inline std::size_t Texture::nearest_texel(float u, float v, int level) const {
     const Level& L = levels_[level];
     const int x = texture_detail::nearest_index<S>(u * L.fwidth, L.width);
     const int y = texture_detail::nearest_index<T>(v * L.fheight, L.height);
-    return texel_at(L.offset + std::size_t(y) * std::size_t(L.width) + std::size_t(x));
+    return L.offset + std::size_t(y) * std::size_t(L.width) + std::size_t(x);
+}
+
+template <Wrap S, Wrap T>
+inline glm::vec4 Texture::nearest_reduced(float u, float v, int level) const {
+    return texel_at(nearest_texel<S, T>(u, v, level));
 }
 
 template <Wrap S, Wrap T>
@@ -373,6 +510,13 @@ template <Wrap S, Wrap T>
 inline glm::vec4 Texture::filtered_wrapped(float u, float v, float lambda) const {
     const float ur = texture_detail::reduce<S>(u), vr = texture_detail::reduce<T>(v);
     const LevelChoice c = choose_level(lambda);
+    if (channels_) {
+        auto one = [&](int level) {
+            return c.nearest ? fix_texel(nearest_texel<S, T>(ur, vr, level)) : fix_bilinear_reduced<S, T>(ur, vr, level);
+        };
+        const Fix4 a = one(c.level);
+        return fix_value(c.blend ? fix_blend(a, one(c.level + 1), c.t) : a);
+    }
     const glm::vec4 a = c.nearest ? nearest_reduced<S, T>(ur, vr, c.level) : bilinear_reduced<S, T>(ur, vr, c.level);
     if (!c.blend) return a;
     const glm::vec4 b =
@@ -405,8 +549,10 @@ inline float Texture::lod(float dudx, float dvdx, float dudy, float dvdy) const 
     const float ax = dudx * w, bx = dvdx * h, ay = dudy * w, by = dvdy * h;
     // log2(rho) = 0.5 log2(rho^2): saves both square roots.
     const float rho2 = std::fmax(ax * ax + bx * bx, ay * ay + by * by);
-    const float lambda = 0.5f * std::log2(rho2);
-    if (lambda != lambda) return 0.0f;  // NaN derivatives
+    if (rho2 != rho2) return 0.0f;                 // NaN derivatives
+    if (!(rho2 >= 1.17549435e-38f)) return -64.0f;  // zero or subnormal: below 2^-63
+    if (!(rho2 <= 3.40282347e38f)) return 64.0f;   // infinite
+    const float lambda = 0.5f * texture_detail::lod_log2(rho2);
     return lambda < -64.0f ? -64.0f : (lambda > 64.0f ? 64.0f : lambda);
 }
 

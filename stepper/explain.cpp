@@ -2,6 +2,7 @@
 #include "stepper/explain.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -99,7 +100,22 @@ const char* wrap_name(Wrap w) {
     return w == Wrap::Repeat ? "repeat" : w == Wrap::MirroredRepeat ? "mirror" : "clamp";
 }
 
-std::string level_footprint(const Texture& tex, glm::vec2 uv, int level) {
+const char* const kChannelNames[4] = {"R", "G", "B", "A"};
+
+// The stored 15-bit codes of one 8-bit texel, per stored channel.
+std::array<int, 4> texel_codes(const Texture& tex, int level, int x, int y) {
+    const std::size_t i = tex.level_offset(level) + std::size_t(y) * std::size_t(tex.width(level)) + std::size_t(x);
+    const std::uint8_t* p = tex.unorm8_data() + i * std::size_t(tex.channels());
+    std::array<int, 4> c = {0, 0, 0, 0};
+    for (int k = 0; k < tex.channels(); ++k) c[std::size_t(k)] = tex.code_table(k)[p[k]];
+    return c;
+}
+
+// One level's bilinear footprint. 8-bit textures: the fixed-point steps of
+// Texture::fix_bilinear() (shading/texture.h), with their integers, into
+// `fixed` when given.
+std::string level_footprint(const Texture& tex, glm::vec2 uv, int level, Texture::Fix4* fixed = nullptr) {
+    using namespace texture_detail;
     const int w = tex.width(level), h = tex.height(level);
     const float x = reduce_wrap(tex.wrap_s(), uv.x) * float(w) - 0.5f;
     const float y = reduce_wrap(tex.wrap_t(), uv.y) * float(h) - 0.5f;
@@ -109,9 +125,23 @@ std::string level_footprint(const Texture& tex, glm::vec2 uv, int level) {
     const int ya = wrap_texel(tex.wrap_t(), y0, h), yb = wrap_texel(tex.wrap_t(), y0 + 1, h);
     std::string s = "level " + std::to_string(level) + " (" + std::to_string(w) + "x" + std::to_string(h) +
                     "): texels x " + std::to_string(xa) + "," + std::to_string(xb) + " y " + std::to_string(ya) +
-                    "," + std::to_string(yb) + " weights " + num(x - fx) + ", " + num(y - fy) + ": " +
-                    vec(tex.texel(level, xa, ya)) + " " + vec(tex.texel(level, xb, ya)) + " " +
-                    vec(tex.texel(level, xa, yb)) + " " + vec(tex.texel(level, xb, yb));
+                    "," + std::to_string(yb) + " weights " + num(x - fx) + ", " + num(y - fy);
+    if (!tex.is_unorm8())
+        return s + ": " + vec(tex.texel(level, xa, ya)) + " " + vec(tex.texel(level, xb, ya)) + " " +
+               vec(tex.texel(level, xa, yb)) + " " + vec(tex.texel(level, xb, yb));
+    const int wx = weight8(x - fx), wy = weight8(y - fy);
+    s += " = " + std::to_string(wx) + "/256, " + std::to_string(wy) + "/256";
+    const std::array<int, 4> a = texel_codes(tex, level, xa, ya), b = texel_codes(tex, level, xb, ya);
+    const std::array<int, 4> c = texel_codes(tex, level, xa, yb), d = texel_codes(tex, level, xb, yb);
+    for (int k = 0; k < tex.channels(); ++k) {
+        const std::size_t i = std::size_t(k);
+        const int top = narrow8(lerp8(a[i], b[i], wx)), bottom = narrow8(lerp8(c[i], d[i], wx));
+        const int v = lerp8(top, bottom, wy);
+        if (fixed) fixed->c[k] = v;
+        s += std::string("; ") + kChannelNames[k] + " codes " + std::to_string(a[i]) + " " + std::to_string(b[i]) +
+             " / " + std::to_string(c[i]) + " " + std::to_string(d[i]) + ", top " + std::to_string(top) +
+             ", bottom " + std::to_string(bottom) + ", " + std::to_string(v);
+    }
     return s;
 }
 
@@ -140,13 +170,23 @@ std::string sampler_text(const Texture& tex) {
 namespace {
 
 // The NEAREST texel of one level: floor(u w), floor(v h), wrapped.
-std::string nearest_footprint(const Texture& tex, glm::vec2 uv, int level) {
+std::string nearest_footprint(const Texture& tex, glm::vec2 uv, int level, Texture::Fix4* fixed = nullptr) {
     const int w = tex.width(level), h = tex.height(level);
     const int x = int(std::floor(reduce_wrap(tex.wrap_s(), uv.x) * float(w)));
     const int y = int(std::floor(reduce_wrap(tex.wrap_t(), uv.y) * float(h)));
     const int xi = wrap_texel(tex.wrap_s(), x, w), yi = wrap_texel(tex.wrap_t(), y, h);
-    return "level " + std::to_string(level) + " (" + std::to_string(w) + "x" + std::to_string(h) + "): nearest texel x " +
-           std::to_string(xi) + " y " + std::to_string(yi) + ": " + vec(tex.texel(level, xi, yi));
+    std::string s = "level " + std::to_string(level) + " (" + std::to_string(w) + "x" + std::to_string(h) +
+                    "): nearest texel x " + std::to_string(xi) + " y " + std::to_string(yi) + ": " +
+                    vec(tex.texel(level, xi, yi));
+    if (tex.is_unorm8()) {
+        const std::array<int, 4> a = texel_codes(tex, level, xi, yi);
+        for (int k = 0; k < tex.channels(); ++k) {
+            if (fixed) fixed->c[k] = a[std::size_t(k)] * 256;
+            s += std::string("; ") + kChannelNames[k] + " code " + std::to_string(a[std::size_t(k)]) + ", " +
+                 std::to_string(a[std::size_t(k)] * 256);
+        }
+    }
+    return s;
 }
 
 // One map: its size, UV set, sampler, the level of detail, the levels and
@@ -179,8 +219,28 @@ std::string map_text(const char* name, const Texture* tex, int uv_set, glm::vec2
         s += std::string(" (") + filter + " on level " + std::to_string(c.level) + ")";
     }
     s += "\n";
-    for (int L : levels)
-        s += std::string(indent) + "  " + (c.nearest ? nearest_footprint(*tex, uv, L) : level_footprint(*tex, uv, L)) + "\n";
+    Texture::Fix4 fixed[2];
+    for (std::size_t i = 0; i < levels.size(); ++i) {
+        const int L = levels[i];
+        s += std::string(indent) + "  " +
+             (c.nearest ? nearest_footprint(*tex, uv, L, &fixed[i]) : level_footprint(*tex, uv, L, &fixed[i])) + "\n";
+    }
+    if (tex->is_unorm8()) {
+        // The fixed-point finish (shading/texture.h): the levels' blend, then
+        // each channel / (32640 * 256).
+        Texture::Fix4 f = fixed[0];
+        if (levels.size() == 2) {
+            using namespace texture_detail;
+            const int wt = weight8(c.t);
+            f = Texture::fix_blend(fixed[0], fixed[1], c.t);
+            s += std::string(indent) + "  blend " + std::to_string(wt) + "/256:";
+            for (int k = 0; k < tex->channels(); ++k)
+                s += std::string(" ") + kChannelNames[k] + " " + std::to_string(narrow8(fixed[0].c[k])) + ", " +
+                     std::to_string(narrow8(fixed[1].c[k])) + " -> " + std::to_string(f.c[k]) + ";";
+            s += "\n";
+        }
+        s += std::string(indent) + "  fixed point / 8355840: " + vec(tex->fix_value(f)) + "\n";
+    }
     s += std::string(indent) + "  sample " + vec(tex->sample_lod(uv.x, uv.y, lambda)) + "\n";
     return s;
 }

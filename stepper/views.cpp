@@ -175,7 +175,7 @@ TextureInfo info_of(const FrameSetup& s, const Entry& e) {
         if (x.is_unorm8()) {
             t.bits = 8;
             t.channels = x.channels();
-            t.colour_space = x.table(0) == srgb8_decode_table() ? "sRGB" : "linear";
+            t.colour_space = x.srgb(0) ? "sRGB" : "linear";
             if (packed(x)) {
                 t.format = "roughness+metal, 2 channels 8-bit linear (samples as G roughness, B metal)";
                 t.png_rule = "RGB: roughness in R and G, metal in B, the stored bytes";
@@ -491,10 +491,12 @@ std::string make_texel(const FrameSetup& s, const Recording&, const std::string&
                     out.decode.push_back(std::string(kRgba[k]) + " = 1 (not stored)");
                     continue;
                 }
-                const bool srgb = tex.table(c) == srgb8_decode_table();
+                const bool srgb = tex.srgb(c);
+                // The 15-bit code the fixed-point filter starts from (shading/texture.h).
+                const int code = tex.code_table(c)[p[c]];
                 out.decode.push_back(std::string(kRgba[k]) + " = " + (srgb ? "sRGB decode of " : "") +
                                      out.stored_names[std::size_t(c)] + " " + std::to_string(int(p[c])) +
-                                     (srgb ? "" : " / 255"));
+                                     (srgb ? "" : " * 128") + " = code " + std::to_string(code) + " / 32640");
             }
         } else {
             out.stored_type = "float32";

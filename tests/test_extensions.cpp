@@ -151,9 +151,17 @@ int checker_texel(glm::dvec2 uv, double margin = 0.02) {
     return ty * 4 + tx;
 }
 
+// What an 8-bit sRGB texture gives for byte b (docs/conventions.md, "Precision
+// of the weights"): the 15-bit code round(decode(b / 255) * 32640) / 32640.
+float srgb_code_value(int b) {
+    const long double c = (long double)b / 255.0L;
+    const long double lin = c <= 0.04045L ? c / 12.92L : std::pow((c + 0.055L) / 1.055L, 2.4L);
+    return float(std::floor(lin * 32640.0L + 0.5L)) / 32640.0f;
+}
+
 glm::vec3 texel_linear(int k) {
-    const float* t = srgb8_to_linear_table();
-    return {t[checker_byte(k, 0)], t[checker_byte(k, 1)], t[checker_byte(k, 2)]};
+    return {srgb_code_value(checker_byte(k, 0)), srgb_code_value(checker_byte(k, 1)),
+            srgb_code_value(checker_byte(k, 2))};
 }
 
 // An unlit quad with the checker as its base colour (NEAREST), the transform

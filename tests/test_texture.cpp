@@ -12,7 +12,9 @@
 #include <string>
 #include <vector>
 
+#include <stb_image.h>
 #include <stb_image_write.h>
+#include <turbojpeg.h>
 
 #include "tests/scratch.h"
 
@@ -512,6 +514,97 @@ TEST_CASE("decode: bad files throw LoadError naming the file") {
     ImageSource nothing;
     nothing.name = "nothing";
     require_load_error(nothing, "nothing");
+}
+
+namespace {
+
+// pixels (w x h, `format` a TJPF_*) compressed by libjpeg-turbo.
+std::vector<unsigned char> tj_compress(const std::vector<unsigned char>& pixels, int w, int h, int format,
+                                       int subsamp, int quality, int flags = 0) {
+    tjhandle tj = tjInitCompress();
+    REQUIRE(tj);
+    unsigned char* out = nullptr;
+    unsigned long size = 0;
+    const int ok = tjCompress2(tj, pixels.data(), w, 0, h, format, &out, &size, subsamp, quality, flags);
+    INFO(tjGetErrorStr2(tj));
+    REQUIRE(ok == 0);
+    std::vector<unsigned char> bytes(out, out + size);
+    tjFree(out);
+    tjDestroy(tj);
+    return bytes;
+}
+
+Image decode_bytes(const std::vector<unsigned char>& bytes, const char* name) {
+    ImageSource src;
+    src.bytes = bytes;
+    src.name = name;
+    return decode_image(src, true);
+}
+
+} // namespace
+
+TEST_CASE("decode: JPEG through libjpeg-turbo (colour, grey, CMYK, progressive)") {
+    // A smooth colour gradient, 4:2:0 at quality 95: within 3 of stb_image's
+    // decode of the same file (the two round their inverse DCTs, chroma
+    // upsampling and colour conversion differently) and within 6 of the source.
+    const int w = 67, h = 45;  // not multiples of the 16x16 MCU
+    std::vector<unsigned char> rgb(std::size_t(w) * h * 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            unsigned char* p = &rgb[(std::size_t(y) * w + x) * 3];
+            p[0] = (unsigned char)(x * 255 / (w - 1));
+            p[1] = (unsigned char)(y * 255 / (h - 1));
+            p[2] = (unsigned char)(128 + (x - y) / 2);
+        }
+    const std::vector<unsigned char> jpg = tj_compress(rgb, w, h, TJPF_RGB, TJSAMP_420, 95);
+    const Image img = decode_bytes(jpg, "gradient.jpg");
+    REQUIRE(img.width == w);
+    REQUIRE(img.height == h);
+    REQUIRE(img.channels == 3);
+    CHECK(img.srgb);
+    int sw = 0, sh = 0, sc = 0;
+    stbi_uc* stb = stbi_load_from_memory(jpg.data(), int(jpg.size()), &sw, &sh, &sc, 3);
+    REQUIRE(stb);
+    int worst_stb = 0, worst_source = 0;
+    for (std::size_t i = 0; i < rgb.size(); ++i) {
+        worst_stb = std::max(worst_stb, std::abs(int(img.pixels[i]) - int(stb[i])));
+        worst_source = std::max(worst_source, std::abs(int(img.pixels[i]) - int(rgb[i])));
+    }
+    stbi_image_free(stb);
+    MESSAGE("JPEG gradient: largest difference " << worst_stb << " from stb_image, " << worst_source
+                                                 << " from the source");
+    CHECK(worst_stb <= 3);
+    CHECK(worst_source <= 6);
+
+    // Progressive coding reorders the same coefficients: the same image.
+    const Image progressive =
+        decode_bytes(tj_compress(rgb, w, h, TJPF_RGB, TJSAMP_420, 95, TJFLAG_PROGRESSIVE), "progressive.jpg");
+    CHECK(progressive.pixels == img.pixels);
+
+    // Grey: one channel.
+    std::vector<unsigned char> grey(std::size_t(w) * h);
+    for (std::size_t i = 0; i < grey.size(); ++i) grey[i] = (unsigned char)(i % 251);
+    const Image g = decode_bytes(tj_compress(grey, w, h, TJPF_GRAY, TJSAMP_GRAY, 100), "grey.jpg");
+    REQUIRE(g.channels == 1);
+    REQUIRE(g.pixels.size() == grey.size());
+
+    // CMYK (stored as Adobe YCCK, inverted): each colour is c * k / 255.
+    // Flat 16x16 squares keep the lossy coding out of the way.
+    const int cw = 32, ch = 32;
+    const unsigned char inks[4][4] = {{255, 128, 0, 255}, {200, 255, 50, 128}, {0, 0, 0, 0}, {255, 255, 255, 64}};
+    std::vector<unsigned char> cmyk(std::size_t(cw) * ch * 4);
+    for (int y = 0; y < ch; ++y)
+        for (int x = 0; x < cw; ++x)
+            for (int c = 0; c < 4; ++c) cmyk[(std::size_t(y) * cw + x) * 4 + c] = inks[(y / 16) * 2 + x / 16][c];
+    const Image k = decode_bytes(tj_compress(cmyk, cw, ch, TJPF_CMYK, TJSAMP_444, 100), "cmyk.jpg");
+    REQUIRE(k.channels == 3);
+    for (int s = 0; s < 4; ++s) {
+        const int x = (s % 2) * 16 + 8, y = (s / 2) * 16 + 8;
+        for (int c = 0; c < 3; ++c) {
+            const int want = (inks[s][c] * inks[s][3] + 127) / 255;
+            CHECK(std::abs(int(k.pixels[(std::size_t(y) * cw + x) * 3 + c]) - want) <= 2);
+        }
+    }
 }
 
 TEST_CASE("decode: randomly corrupted PNG and JPEG never crash") {

@@ -1,5 +1,6 @@
-// 8-bit textures: level 0 samples exactly the floats of the decoded image,
-// every stored mip texel is the correctly rounded byte of the exact
+// 8-bit textures: the fixed-point filter (shading/texture.h) against a
+// reference written from docs/conventions.md and against the float filter of
+// the same image, every stored mip texel is the correctly rounded byte of the exact
 // area-weighted box filter of the level above (in linear space for sRGB
 // channels), the memory a texture takes, packed roughness + metal maps, and
 // mip chains independent of the thread count.
@@ -145,30 +146,143 @@ TEST_CASE("8-bit mips: each texel is the correctly rounded exact box filter of t
     CHECK(near_ties <= 2);
 }
 
-TEST_CASE("8-bit level 0 samples exactly the floats of the decoded image") {
+namespace {
+
+// The conventions' 15-bit code of a byte, written apart from the texture's
+// tables: b * 128 when linear, else round(decode(b / 255) * 32640), decode
+// in long double.
+int reference_code(int b, bool srgb) {
+    if (!srgb) return b * 128;
+    const long double c = (long double)b / 255.0L;
+    const long double lin = c <= 0.04045L ? c / 12.92L : std::pow((c + 0.055L) / 1.055L, 2.4L);
+    return int(std::floor(lin * 32640.0L + 0.5L));
+}
+
+// The conventions' bilinear filter of one level of an 8-bit texture that
+// repeats in both axes, per stored channel, as an integer over 32640 * 256.
+std::vector<long long> reference_bilinear(const Image& img, float u, float v) {
+    const int w = img.width, h = img.height, C = img.channels;
+    const float ur = u - std::floor(u), vr = v - std::floor(v);
+    const float x = ur * float(w) - 0.5f, y = vr * float(h) - 0.5f;
+    const float fx = std::floor(x), fy = std::floor(y);
+    const long long wx = (long long)((x - fx) * 256.0f + 0.5f), wy = (long long)((y - fy) * 256.0f + 0.5f);
+    auto wrap = [](int i, int n) { return ((i % n) + n) % n; };
+    const int x0 = wrap(int(fx), w), x1 = wrap(int(fx) + 1, w), y0 = wrap(int(fy), h), y1 = wrap(int(fy) + 1, h);
+    std::vector<long long> out;
+    for (int c = 0; c < C; ++c) {
+        const bool srgb = img.srgb && !(c == C - 1 && (C == 2 || C == 4));
+        auto code = [&](int xx, int yy) {
+            return (long long)reference_code(img.pixels[(std::size_t(yy) * std::size_t(w) + std::size_t(xx)) * std::size_t(C) + std::size_t(c)], srgb);
+        };
+        const long long top = (code(x0, y0) * (256 - wx) + code(x1, y0) * wx + 128) / 256;
+        const long long bottom = (code(x0, y1) * (256 - wx) + code(x1, y1) * wx + 128) / 256;
+        out.push_back(top * (256 - wy) + bottom * wy);
+    }
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("8-bit textures filter in fixed point as the conventions define it") {
     std::mt19937 rng(80u);
     std::uniform_real_distribution<float> uni(-2.0f, 2.0f);
+    double worst_float = 0.0;
     for (int channels = 1; channels <= 4; ++channels)
         for (bool srgb : {false, true}) {
             const Image img = random_unorm8(rng, 19, 12, channels, srgb);
-            const Texture t8 = Texture::from_image(img, Wrap::Repeat, Wrap::MirroredRepeat);
-            const Texture tf = Texture::from_image(to_float(img), Wrap::Repeat, Wrap::MirroredRepeat);
+            const Texture t8 = Texture::from_image(img, Wrap::Repeat, Wrap::Repeat);
+            const Texture tf = Texture::from_image(to_float(img), Wrap::Repeat, Wrap::Repeat);
             CHECK(!tf.is_unorm8());
+            // Texels: linear bytes exactly b / 255; sRGB ones the code / 32640,
+            // within half a code of the float decode.
             for (int y = 0; y < 12; ++y)
-                for (int x = 0; x < 19; ++x) REQUIRE(t8.texel(0, x, y) == tf.texel(0, x, y));
+                for (int x = 0; x < 19; ++x) {
+                    const glm::vec4 a = t8.texel(0, x, y), b = tf.texel(0, x, y);
+                    for (int c = 0; c < 4; ++c) {
+                        if (!srgb || c == 3) REQUIRE(a[c] == b[c]);
+                        else REQUIRE(std::fabs(a[c] - b[c]) <= 0.5f / 32640.0f + 1e-7f);
+                    }
+                }
+            const int n_out = channels <= 2 ? 1 : 3;  // stored channels that reach r (g, b)
             for (int k = 0; k < 2000; ++k) {
                 const float u = uni(rng), v = uni(rng);
-                const glm::vec4 a = t8.sample_bilinear(u, v, 0), b = tf.sample_bilinear(u, v, 0);
-                for (int c = 0; c < 4; ++c) REQUIRE(bits(a[c]) == bits(b[c]));
-                // Magnification (lambda <= 0) reads level 0 only: identical too.
+                const glm::vec4 a = t8.sample_bilinear(u, v, 0), f = tf.sample_bilinear(u, v, 0);
+                const std::vector<long long> ref = reference_bilinear(img, u, v);
+                for (int c = 0; c < n_out; ++c) {
+                    REQUIRE(bits(a[c]) == bits(float(double(ref[std::size_t(c)])) / 8355840.0f));
+                    // Against float filtering: each 8-bit weight moves a result by
+                    // at most 1/512 of a step, plus the codes' roundings.
+                    worst_float = std::max(worst_float, double(std::fabs(a[c] - f[c])));
+                    REQUIRE(std::fabs(a[c] - f[c]) <= 2.0f / 512.0f + 3.0f / 32640.0f);
+                }
+                if (channels == 2 || channels == 4)
+                    REQUIRE(bits(a.a) == bits(float(double(ref[std::size_t(channels - 1)])) / 8355840.0f));
+                // Magnification (lambda <= 0) reads level 0 only.
                 const glm::vec4 m = t8.sample_trilinear(u, v, -1.5f);
-                for (int c = 0; c < 4; ++c) REQUIRE(bits(m[c]) == bits(b[c]));
+                for (int c = 0; c < 4; ++c) REQUIRE(bits(m[c]) == bits(a[c]));
             }
             // Grey replicates to r, g, b; no alpha channel reads 1.
             const glm::vec4 t = t8.texel(0, 3, 4);
             if (channels <= 2) CHECK((t.r == t.g && t.g == t.b));
             if (channels % 2 == 1) CHECK(t.a == 1.0f);
         }
+    MESSAGE("largest difference from float filtering: " << worst_float);
+}
+
+TEST_CASE("fixed-point filtering: analytic cases") {
+    // Two linear texels 0 and 255, repeating: x = u * 2 - 0.5. Half way
+    // between the centres (u = 0.5) the weight is 128/256 and the result
+    // exactly 0.5; a texel centre returns the texel exactly.
+    Image img;
+    img.width = 2;
+    img.height = 1;
+    img.channels = 1;
+    img.pixels = {0, 255};
+    const Texture t = Texture::from_image(img, Wrap::ClampToEdge, Wrap::ClampToEdge);
+    CHECK(t.sample_bilinear(0.5f, 0.5f, 0).r == 0.5f);
+    CHECK(t.sample_bilinear(0.25f, 0.5f, 0).r == 0.0f);
+    CHECK(t.sample_bilinear(0.75f, 0.5f, 0).r == 1.0f);
+    // A weight of 1/3 rounds to 85/256: (32640 * 85 + 128) >> 8 = 10838.
+    const float u = (0.5f + 1.0f / 3.0f) / 2.0f;
+    CHECK(t.sample_bilinear(u, 0.5f, 0).r == float(10838 * 256) / 8355840.0f);
+    // Every 8-bit byte of a constant texture, linear or sRGB, samples to its
+    // own texel value at any position and level.
+    for (bool srgb : {false, true})
+        for (int b = 0; b < 256; b += 17) {
+            Image c;
+            c.width = 5;
+            c.height = 3;
+            c.channels = 3;
+            c.srgb = srgb;
+            c.pixels.assign(15 * 3, std::uint8_t(b));
+            const Texture ct = Texture::from_image(c);
+            const float want = ct.texel(0, 0, 0).r;
+            for (float lambda : {-1.0f, 0.3f, 1.7f, 5.0f}) CHECK(ct.sample_trilinear(0.37f, 0.81f, lambda).r == want);
+        }
+    // The level blend: t = 0.25 is 64/256 between two constant levels.
+    Image g;
+    g.width = 2;
+    g.height = 2;
+    g.channels = 1;
+    g.pixels = {0, 255, 255, 0};  // level 1 is the mean, 128
+    const Texture gt = Texture::from_image(g);
+    const float l0 = gt.sample_bilinear(0.25f, 0.25f, 0).r;  // texel 0: 0
+    CHECK(l0 == 0.0f);
+    const int code1 = 128 * 128;
+    CHECK(gt.sample_trilinear(0.25f, 0.25f, 0.25f).r == float(code1 * 64) / 8355840.0f);
+}
+
+TEST_CASE("the level of detail's log2 is within 4e-6 of log2 and exact at powers of two") {
+    for (int e = -60; e <= 60; ++e) CHECK(texture_detail::lod_log2(std::ldexp(1.0f, e)) == float(e));
+    std::mt19937 rng(7u);
+    std::uniform_real_distribution<float> mant(1.0f, 2.0f);
+    double worst = 0.0;
+    for (int k = 0; k < 100000; ++k) {
+        const float x = std::ldexp(mant(rng), int(k % 40) - 20);
+        worst = std::max(worst, std::fabs(double(texture_detail::lod_log2(x)) - std::log2(double(x))));
+    }
+    MESSAGE("largest error of lod_log2: " << worst);
+    CHECK(worst < 4e-6);  // 2.8e-6 from the table, the rest the sum's rounding
 }
 
 TEST_CASE("8-bit storage: a texture takes its 8-bit size plus a third for the mips") {
