@@ -5,7 +5,7 @@
 # and line) compiles in half the time of -g. Reports inside
 # Debian's stb_image 2.27 that are known and harmless are suppressed by
 # tests/ubsan.supp (each entry says why); the ones that are not harmless are
-# guarded before stb sees the data (scene/hdr_guard.h, scene/jpeg_guard.h).
+# guarded before stb sees the data (scene/hdr_guard.h).
 #   sh .ci/steps/20-sanitize.sh            (from the top folder; builds build-asan/)
 set -e
 cd "$(dirname "$0")/../.."
