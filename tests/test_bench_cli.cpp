@@ -114,6 +114,32 @@ TEST_CASE("bench: writes its workloads and measures them, in text, JSON, alterna
     CHECK(s.out.find("side by side, 1 alternating runs each") != std::string::npos);
     CHECK(s.out.find("grid     whole process A ") != std::string::npos);
     CHECK(s.out.find("frame median A ") != std::string::npos);
+
+    // Side by side in JSON, every thread count and sample count: one object each.
+    CliRun sj = box.run_exe(PRAST_BENCH_EXE, {"--side-by-side", PRAST_RENDER_EXE, PRAST_RENDER_EXE, "--workloads", dir,
+                                              "--workload", "grid", "--threads", "1,2", "--msaa", "1,4", "--runs", "2",
+                                              "--repeat", "1", "--json"});
+    REQUIRE(sj.code == 0);
+    CHECK(sj.out.front() == '[');
+    CHECK(sj.out.find("side by side") == std::string::npos);  // JSON only
+    const std::vector<std::string> pairs = json_objects(sj.out);
+    REQUIRE(pairs.size() == 4);
+    const double want[4][2] = {{1, 1}, {1, 4}, {2, 1}, {2, 4}};
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+        INFO(pairs[i]);
+        CHECK(number(pairs[i], "threads") == want[i][0]);
+        CHECK(number(pairs[i], "msaa") == want[i][1]);
+        CHECK(number(pairs[i], "msaa_b") == want[i][1]);  // this render takes --msaa
+        CHECK(number(pairs[i], "runs") == 2);
+        check_summary(pairs[i], "rounds");
+        for (const char* k : {"whole_ms", "frame_ms"}) {
+            const std::size_t at = pairs[i].find(std::string("\"") + k + "\":{");
+            REQUIRE(at != std::string::npos);
+            const std::string o = pairs[i].substr(at, pairs[i].find('}', at) - at);
+            CHECK(number(o, "a") > 0.0);
+            CHECK(number(o, "b") > 0.0);
+        }
+    }
 }
 
 TEST_CASE("bench: PSNR of two images, and bad arguments are one line and a non-zero exit") {

@@ -20,7 +20,8 @@ const char* const kBenchHead =
     "       bench SCENE [--size WxH] [--threads 1,2] [--tiles 64] [--repeat N] [--view NAME] [--flat]\n"
     "             [--shadows on|off|both] [--shadow-size N] [--blend ALPHA]\n"
     "       bench --write-workloads DIR\n"
-    "       bench --side-by-side RENDER_A RENDER_B [--workload ...] [--msaa 1,4] [--runs N] [--repeat N]\n"
+    "       bench --side-by-side RENDER_A RENDER_B [--workload ...] [--threads 1,2] [--msaa 1,4] [--runs N] [--repeat N]\n"
+    "             [--json]  (each thread count and sample count in turn)\n"
     "       bench --psnr A.png B.png\n"
     "options:\n";
 
@@ -272,7 +273,7 @@ std::string bench_markdown() {
     return set.markdown("bench [--workload LIST] [--threads LIST] [--msaa LIST] [--repeat N] [--json] [--alternate]\n"
                         "bench SCENE [--size WxH] [--tiles LIST] [--view NAME] [--flat] [--blend ALPHA] ...\n"
                         "bench --write-workloads DIR\n"
-                        "bench --side-by-side RENDER_A RENDER_B [--workload LIST] [--runs N] [--repeat N]\n"
+                        "bench --side-by-side RENDER_A RENDER_B [--workload LIST] [--threads LIST] [--msaa LIST] [--runs N] [--repeat N] [--json]\n"
                         "bench --psnr A.png B.png",
                         "Frame times of the full pipeline on the speed workloads (a developer tool, "
                         "tools/bench/). Timing lives here, never in the tests. Exit codes: 0 ok, 1 a failed "

@@ -14,7 +14,9 @@
 //   bench --alternate [--threads 1,2] ...  one process, frames of each thread count in
 //                                        turn; prints the median of the rounds' speed-ups
 //   bench --write-workloads DIR          the synthetic workloads as files, plus DIR/commands.txt
-//   bench --side-by-side RENDER_A RENDER_B [--workload ...] [--runs N] [--repeat N]
+//   bench --side-by-side RENDER_A RENDER_B [--workload ...] [--threads 1,2] [--msaa 1,4]
+//                                        [--runs N] [--repeat N] [--json]
+//                                        each thread count and sample count in turn
 //   bench --psnr A.png B.png
 //
 // The workloads (1920x1080, one sun, ambient 0.05, ACES): quad (two triangles
@@ -591,11 +593,14 @@ bool takes_msaa(const std::string& exe) {
     return status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
+// With `json`, each workload's figures go to `out` as a JSON object instead
+// of a printed line.
 int side_by_side(const std::vector<std::string>& exes, const std::vector<Workload>& list, int runs, int repeat,
-                 const std::string& threads, int samples) {
+                 const std::string& threads, int samples, bool json, std::vector<std::string>& out_json) {
     const fs::path out_png = fs::temp_directory_path() / ("prast_bench_" + std::to_string(long(getpid())) + ".png");
     const bool msaa[2] = {takes_msaa(exes[0]), takes_msaa(exes[1])};
-    std::printf("side by side, %d alternating runs each, %s threads; A = %s (%s), B = %s (%s)\n", runs,
+    if (!json)
+        std::printf("side by side, %d alternating runs each, %s threads; A = %s (%s), B = %s (%s)\n", runs,
                 threads.c_str(), exes[0].c_str(),
                 msaa[0] ? ("--msaa " + std::to_string(samples)).c_str() : "no --msaa: 1 sample", exes[1].c_str(),
                 msaa[1] ? ("--msaa " + std::to_string(samples)).c_str() : "no --msaa: 1 sample");
@@ -629,6 +634,18 @@ int side_by_side(const std::vector<std::string>& exes, const std::vector<Workloa
         std::vector<double> rounds;
         for (int i = 0; i < runs; ++i) rounds.push_back(frame[0][std::size_t(i)] / frame[1][std::size_t(i)]);
         const Summary fr = summarise(rounds);
+        if (json) {
+            char b[768];
+            std::snprintf(b, sizeof b,
+                          "{\"workload\":\"%s\",\"threads\":%s,\"msaa\":%d,\"msaa_a\":%d,\"msaa_b\":%d,\"runs\":%d,"
+                          "\"whole_ms\":{\"a\":%.3f,\"b\":%.3f},\"frame_ms\":{\"a\":%.3f,\"b\":%.3f},"
+                          "\"rounds\":{\"min\":%.4f,\"median\":%.4f,\"max\":%.4f},"
+                          "\"textures_ms\":{\"a\":%.3f,\"b\":%.3f}}",
+                          w.name.c_str(), threads.c_str(), samples, msaa[0] ? samples : 1, msaa[1] ? samples : 1, runs,
+                          wa.median, wb.median, fa.median, fb.median, fr.min, fr.median, fr.max, ta.median, tb.median);
+            out_json.push_back(b);
+            continue;
+        }
         std::printf("%-8s whole process A %.1f ms B %.1f ms (A/B %.2fx) | frame median A %.2f ms B %.2f ms "
                     "(A/B %.2fx; rounds %.2fx, %.2fx..%.2fx) | textures A %.1f ms B %.1f ms\n",
                     w.name.c_str(), wa.median, wb.median, wa.median / wb.median, fa.median, fb.median,
@@ -821,8 +838,15 @@ int main(int argc, char** argv) {
             list.push_back(w);
         }
         if (!exes.empty()) {
-            for (int m : msaa)
-                if (int rc = side_by_side(exes, list, runs, repeat, std::to_string(threads.back()), m)) return rc;
+            std::vector<std::string> out;
+            for (int t : threads)
+                for (int m : msaa)
+                    if (int rc = side_by_side(exes, list, runs, repeat, std::to_string(t), m, json, out)) return rc;
+            if (json) {
+                std::printf("[");
+                for (std::size_t i = 0; i < out.size(); ++i) std::printf("%s%s\n", i ? "," : "", out[i].c_str());
+                std::printf("]\n");
+            }
             return 0;
         }
         std::vector<std::string> out;
