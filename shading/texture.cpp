@@ -116,6 +116,12 @@ IntTaps int_taps(int n, int i) {
     return t;
 }
 
+// The exact sRGB transfer function (IEC 61966-2-1) in double: the reference
+// both the mip re-encoding and the filter's sRGB codes round from.
+double srgb_decode_exact(double c) {
+    return c <= 0.04045 ? c / 12.92 : det::pow((c + 0.055) / 1.055, 2.4);
+}
+
 // Re-encoding linear values to sRGB bytes, correctly rounded: byte b is the
 // number of thresholds T_k = decode((k + 0.5) / 255), k = 0..254, at or below
 // the value (ties round up), with decode the exact sRGB transfer function in
@@ -126,10 +132,7 @@ struct SrgbEncoder {
     std::uint8_t start[4097];
 
     SrgbEncoder() {
-        for (int k = 0; k < 255; ++k) {
-            const double c = (double(k) + 0.5) / 255.0;
-            threshold[k] = c <= 0.04045 ? c / 12.92 : det::pow((c + 0.055) / 1.055, 2.4);
-        }
+        for (int k = 0; k < 255; ++k) threshold[k] = srgb_decode_exact((double(k) + 0.5) / 255.0);
         threshold[255] = HUGE_VAL;
         int b = 0;
         for (int i = 0; i <= 4096; ++i) {
@@ -272,9 +275,8 @@ struct CodeTables {
 
     CodeTables() {
         for (int b = 0; b < 256; ++b) {
-            const double c = double(b) / 255.0;
-            const double lin = c <= 0.04045 ? c / 12.92 : det::pow((c + 0.055) / 1.055, 2.4);
             linear[b] = std::uint16_t(b * 128);
+            const double lin = srgb_decode_exact(double(b) / 255.0);
             srgb[b] = std::uint16_t(std::floor(lin * double(texture_detail::kFixOne) + 0.5));
             srgb_value[b] = float(srgb[b]) / float(texture_detail::kFixOne);
         }
@@ -381,12 +383,10 @@ Texture Texture::from_image(Image img, Wrap s, Wrap t, ThreadPool* pool) {
         // Grey and grey+alpha replicate their first channel to r, g, b.
         static const int kSwizzle[5][4] = {
             {0, 1, 2, 3}, {0, 0, 0, kOne}, {0, 0, 0, 1}, {0, 1, 2, kOne}, {0, 1, 2, 3}};
-        const float* colour = img.srgb ? srgb8_decode_table() : unorm8_decode_table();
-        const float* linear = unorm8_decode_table();
-        const bool has_alpha = img.channels == 2 || img.channels == 4;
-        const float* tables[4] = {colour, colour, colour, colour};
-        if (has_alpha) tables[img.channels - 1] = linear;
-        return from_unorm8(img.pixels.data(), img.channels, tables, kSwizzle[img.channels], img.width,
+        // Alpha (channel 1 of 2, 3 of 4) is linear whatever the colour is.
+        bool srgb[4] = {img.srgb, img.srgb, img.srgb, img.srgb};
+        if (img.channels == 2 || img.channels == 4) srgb[img.channels - 1] = false;
+        return from_unorm8(img.pixels.data(), img.channels, srgb, kSwizzle[img.channels], img.width,
                            img.height, s, t, pool);
     }
     if (img.rgba.size() != count0 * 4)
@@ -417,20 +417,18 @@ Texture Texture::from_image(Image img, Wrap s, Wrap t, ThreadPool* pool) {
     return tex;
 }
 
-Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const float* const tables[4],
-                             const int swizzle[4], int w, int h, Wrap s, Wrap t, ThreadPool* pool) {
+Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const bool srgb[4], const int swizzle[4],
+                             int w, int h, Wrap s, Wrap t, ThreadPool* pool) {
     Texture tex;
     tex.set_sampler(SamplerState{s, t});
     tex.channels_ = channels;
-    bool srgb_channel[4] = {false, false, false, false};
     const CodeTables& codes = code_tables();
     for (int c = 0; c < 4; ++c) {
         tex.swizzle_[c] = swizzle[c];
-        srgb_channel[c] = c < channels && tables[c] == srgb8_decode_table();
-        tex.srgb_[c] = srgb_channel[c];
+        tex.srgb_[c] = c < channels && srgb[c];
         // Linear: b * 128 / 32640 is b / 255, which unorm8_decode_table() holds.
-        tex.code_[c] = srgb_channel[c] ? codes.srgb : codes.linear;
-        tex.table_[c] = srgb_channel[c] ? codes.srgb_value : unorm8_decode_table();
+        tex.code_[c] = tex.srgb_[c] ? codes.srgb : codes.linear;
+        tex.table_[c] = tex.srgb_[c] ? codes.srgb_value : unorm8_decode_table();
     }
     tex.layout(w, h);
     const std::size_t C = std::size_t(channels);
@@ -446,7 +444,7 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const flo
         const Level& b = tex.levels_[l];
         for_row_chunks(pool, b.height, std::size_t(b.width), [&](int j0, int j1) {
             downsample_unorm8(base + a.offset * C, a.width, a.height, base + b.offset * C, b.width, j0, j1,
-                              channels, srgb_channel);
+                              channels, tex.srgb_);
         });
     }
     tex.memory_bytes_ = tex.total_texels_ * C;
@@ -463,8 +461,7 @@ Texture Texture::pack_roughness_metal(const Image& rough, const Image& metal, Wr
     if (rough.pixels.size() != rough.texel_count() * std::size_t(rough.channels) ||
         metal.pixels.size() != metal.texel_count() * std::size_t(metal.channels))
         throw std::invalid_argument("Texture::pack_roughness_metal: wrong data size");
-    const float* linear = unorm8_decode_table();
-    const float* tables[4] = {linear, linear, linear, linear};
+    static const bool kLinear[4] = {false, false, false, false};
     static const int kSwizzle[4] = {0, 0, 1, kOne};
     const std::size_t n = rough.texel_count();
     std::unique_ptr<std::uint8_t[], FreeBytes> packed(allocate_texels(n * 2));
@@ -473,7 +470,7 @@ Texture Texture::pack_roughness_metal(const Image& rough, const Image& metal, Wr
         packed[2 * i] = rough.pixels[i * rc];
         packed[2 * i + 1] = metal.pixels[i * mc];
     }
-    return from_unorm8(packed.get(), 2, tables, kSwizzle, rough.width, rough.height, s, t, pool);
+    return from_unorm8(packed.get(), 2, kLinear, kSwizzle, rough.width, rough.height, s, t, pool);
 }
 
 glm::vec4 Texture::texel(int level, int x, int y) const {

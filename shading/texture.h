@@ -236,8 +236,9 @@ private:
 
     // Lays out the chain for a w x h level 0.
     void layout(int w, int h);
-    static Texture from_unorm8(const std::uint8_t* level0, int channels, const float* const tables[4],
-                               const int swizzle[4], int w, int h, Wrap s, Wrap t, ThreadPool* pool);
+    // srgb[c]: stored channel c holds sRGB-encoded colour.
+    static Texture from_unorm8(const std::uint8_t* level0, int channels, const bool srgb[4], const int swizzle[4],
+                               int w, int h, Wrap s, Wrap t, ThreadPool* pool);
 
     struct FreeBytes {
         void operator()(std::uint8_t* p) const { std::free(p); }
