@@ -413,12 +413,15 @@ constexpr int kSparseLanes = 4;
 template <int N>
 inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
     constexpr int W = N >= 8 ? 8 : 4;
-    const bool sparse = __builtin_popcount(at.live) <= kSparseLanes;
+    if (__builtin_popcount(at.live) <= kSparseLanes) {
+        fetch_fix_one_by_one<N>(tex, at, out);  // any channel count
+        return;
+    }
     switch (tex.channels()) {
-    case 1: sparse ? fetch_fix_one_by_one<N>(tex, at, out) : fetch_unorm8_lanes<N, W, 1>(tex, at, out, components); return;
-    case 2: sparse ? fetch_fix_one_by_one<N>(tex, at, out) : fetch_unorm8_lanes<N, W, 2>(tex, at, out, components); return;
-    case 3: sparse ? fetch_fix_one_by_one<N>(tex, at, out) : fetch_unorm8_lanes<N, W, 3>(tex, at, out, components); return;
-    default: sparse ? fetch_fix_one_by_one<N>(tex, at, out) : fetch_unorm8_lanes<N, W, 4>(tex, at, out, components); return;
+    case 1: fetch_unorm8_lanes<N, W, 1>(tex, at, out, components); return;
+    case 2: fetch_unorm8_lanes<N, W, 2>(tex, at, out, components); return;
+    case 3: fetch_unorm8_lanes<N, W, 3>(tex, at, out, components); return;
+    default: fetch_unorm8_lanes<N, W, 4>(tex, at, out, components); return;
     }
 }
 
