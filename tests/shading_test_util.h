@@ -2,6 +2,7 @@
 // scalar reference bit for bit.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <random>
@@ -31,6 +32,17 @@ inline void add_test_lights(ShadingContext& ctx, std::mt19937& rng) {
     lamp.position = {1.0f, 2.0f, 3.0f};
     lamp.radiance = {10.0f, 12.0f, 14.0f};
     ctx.lights = {sun, lamp};
+}
+
+// The 15-bit code of an 8-bit texel's byte in the fixed-point filter
+// (docs/conventions.md, "Precision of the weights"), written apart from the
+// texture's tables: b * 128 when linear, else round(decode(b / 255) * 32640),
+// the decode in long double.
+inline int reference_code(int b, bool srgb) {
+    if (!srgb) return b * 128;
+    const long double c = (long double)b / 255.0L;
+    const long double lin = c <= 0.04045L ? c / 12.92L : std::pow((c + 0.055L) / 1.055L, 2.4L);
+    return int(std::floor(lin * 32640.0L + 0.5L));
 }
 
 } // namespace prast::test

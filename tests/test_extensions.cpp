@@ -151,13 +151,8 @@ int checker_texel(glm::dvec2 uv, double margin = 0.02) {
     return ty * 4 + tx;
 }
 
-// What an 8-bit sRGB texture gives for byte b (docs/conventions.md, "Precision
-// of the weights"): the 15-bit code round(decode(b / 255) * 32640) / 32640.
-float srgb_code_value(int b) {
-    const long double c = (long double)b / 255.0L;
-    const long double lin = c <= 0.04045L ? c / 12.92L : std::pow((c + 0.055L) / 1.055L, 2.4L);
-    return float(std::floor(lin * 32640.0L + 0.5L)) / 32640.0f;
-}
+// What an 8-bit sRGB texture gives for byte b: its 15-bit code / 32640.
+float srgb_code_value(int b) { return float(test::reference_code(b, true)) / 32640.0f; }
 
 glm::vec3 texel_linear(int k) {
     return {srgb_code_value(checker_byte(k, 0)), srgb_code_value(checker_byte(k, 1)),

@@ -19,6 +19,7 @@
 
 using namespace prast;
 using prast::test::bits;
+using prast::test::reference_code;
 
 namespace {
 
@@ -147,16 +148,6 @@ TEST_CASE("8-bit mips: each texel is the correctly rounded exact box filter of t
 }
 
 namespace {
-
-// The conventions' 15-bit code of a byte, written apart from the texture's
-// tables: b * 128 when linear, else round(decode(b / 255) * 32640), decode
-// in long double.
-int reference_code(int b, bool srgb) {
-    if (!srgb) return b * 128;
-    const long double c = (long double)b / 255.0L;
-    const long double lin = c <= 0.04045L ? c / 12.92L : std::pow((c + 0.055L) / 1.055L, 2.4L);
-    return int(std::floor(lin * 32640.0L + 0.5L));
-}
 
 // The conventions' bilinear filter of one level of an 8-bit texture that
 // repeats in both axes, per stored channel, as an integer over 32640 * 256.
