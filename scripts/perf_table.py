@@ -24,7 +24,6 @@ import argparse
 import datetime
 import json
 import os
-import re
 import subprocess
 import sys
 
@@ -36,22 +35,16 @@ DATA_BEGIN, DATA_END = "<!-- perf-data begin -->", "<!-- perf-data end -->"
 # Workloads whose llvmpipe frame is not the same picture.
 NOT_COMPARABLE = {"builtin": "its sky is image-based lighting, which llvmpipe-render does not draw"}
 
-# One line of `bench --side-by-side A B` per workload (tools/bench/bench.cpp).
-SIDE_LINE = re.compile(
-    r"^(?P<workload>\S+)\s+whole process A (?P<whole_a>[\d.]+) ms B (?P<whole_b>[\d.]+) ms .*?"
-    r"\| frame median A (?P<frame_a>[\d.]+) ms B (?P<frame_b>[\d.]+) ms "
-    r"\(A/B [\d.]+x; rounds (?P<rounds>[\d.]+)x, (?P<rounds_min>[\d.]+)x\.\.(?P<rounds_max>[\d.]+)x\)"
-    r"(?: \| textures A (?P<textures_a>-?[\d.]+) ms B (?P<textures_b>-?[\d.]+) ms)?")
-
-
-def parse_side_by_side(text):
-    """{workload: {...}} from side-by-side output (A = llvmpipe or the older build, B = ours)."""
+def side_by_side_entries(objects):
+    """{workload: {...}} from `bench --side-by-side A B --json` (A = llvmpipe or the older build, B = ours)."""
     out = {}
-    for line in text.splitlines():
-        m = SIDE_LINE.match(line)
-        if m:
-            d = {k: float(v) for k, v in m.groupdict().items() if k != "workload" and v is not None}
-            out[m.group("workload")] = d
+    for o in objects:
+        out[o["workload"]] = {
+            "whole_a": o["whole_ms"]["a"], "whole_b": o["whole_ms"]["b"],
+            "frame_a": o["frame_ms"]["a"], "frame_b": o["frame_ms"]["b"],
+            "rounds": o["rounds"]["median"], "rounds_min": o["rounds"]["min"], "rounds_max": o["rounds"]["max"],
+            "textures_a": o["textures_ms"]["a"], "textures_b": o["textures_ms"]["b"],
+        }
     return out
 
 
@@ -86,11 +79,11 @@ def int_list(text):
 
 def side_by_side(args, exe_a, threads, msaa):
     cmd = [args.bench, "--side-by-side", exe_a, args.render, "--threads", str(threads), "--msaa", str(msaa),
-           "--runs", str(args.runs), "--repeat", str(args.repeat)]
+           "--runs", str(args.runs), "--repeat", str(args.repeat), "--json"]
     if args.workload:
         cmd[4:4] = ["--workload", args.workload]
     print("running:", " ".join(cmd), file=sys.stderr)
-    return parse_side_by_side(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout)
+    return side_by_side_entries(json.loads(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout))
 
 
 def run(args):
