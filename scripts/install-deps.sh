@@ -1,10 +1,10 @@
 #!/bin/sh
 # Installs the Debian 12 packages prast builds with (compiler, CMake, the
 # header-only libraries, and zlib, libpng, libdeflate, libturbojpeg, libwebp
-# and libdraco, linked statically; libmeshoptimizer only for the tests, which encode with
-# it; pybind11, the Python headers and numpy for the Python module, pytest
-# for its tests), those not installed yet (scripts/install-packages.sh: apt-get
-# through sudo unless already root).
+# and libdraco, linked statically; libmeshoptimizer only for the tests, which
+# encode with it; pybind11, the Python headers and numpy for the Python
+# module, pytest for its tests), those not installed yet
+# (scripts/install-packages.sh: apt-get through sudo unless already root).
 set -e
 PACKAGES="
   build-essential

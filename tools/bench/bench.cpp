@@ -593,6 +593,13 @@ bool takes_msaa(const std::string& exe) {
     return status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
+// The JSON objects of --json as one array, an object a line.
+void print_json_array(const std::vector<std::string>& objects) {
+    std::printf("[");
+    for (std::size_t i = 0; i < objects.size(); ++i) std::printf("%s%s\n", i ? "," : "", objects[i].c_str());
+    std::printf("]\n");
+}
+
 // With `json`, each workload's figures go to `out` as a JSON object instead
 // of a printed line.
 int side_by_side(const std::vector<std::string>& exes, const std::vector<Workload>& list, int runs, int repeat,
@@ -601,9 +608,9 @@ int side_by_side(const std::vector<std::string>& exes, const std::vector<Workloa
     const bool msaa[2] = {takes_msaa(exes[0]), takes_msaa(exes[1])};
     if (!json)
         std::printf("side by side, %d alternating runs each, %s threads; A = %s (%s), B = %s (%s)\n", runs,
-                threads.c_str(), exes[0].c_str(),
-                msaa[0] ? ("--msaa " + std::to_string(samples)).c_str() : "no --msaa: 1 sample", exes[1].c_str(),
-                msaa[1] ? ("--msaa " + std::to_string(samples)).c_str() : "no --msaa: 1 sample");
+                    threads.c_str(), exes[0].c_str(),
+                    msaa[0] ? ("--msaa " + std::to_string(samples)).c_str() : "no --msaa: 1 sample", exes[1].c_str(),
+                    msaa[1] ? ("--msaa " + std::to_string(samples)).c_str() : "no --msaa: 1 sample");
     for (const Workload& w : list) {
         std::vector<double> whole[2], frame[2], textures[2];
         for (int i = 0; i < runs; ++i)
@@ -842,11 +849,7 @@ int main(int argc, char** argv) {
             for (int t : threads)
                 for (int m : msaa)
                     if (int rc = side_by_side(exes, list, runs, repeat, std::to_string(t), m, json, out)) return rc;
-            if (json) {
-                std::printf("[");
-                for (std::size_t i = 0; i < out.size(); ++i) std::printf("%s%s\n", i ? "," : "", out[i].c_str());
-                std::printf("]\n");
-            }
+            if (json) print_json_array(out);
             return 0;
         }
         std::vector<std::string> out;
@@ -866,11 +869,7 @@ int main(int argc, char** argv) {
                         out.push_back(json_result(r));
                     }
             }
-        if (json) {
-            std::printf("[");
-            for (std::size_t i = 0; i < out.size(); ++i) std::printf("%s%s\n", i ? "," : "", out[i].c_str());
-            std::printf("]\n");
-        }
+        if (json) print_json_array(out);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench: %s\n", e.what());
         return 1;
