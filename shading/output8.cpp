@@ -1,11 +1,13 @@
-// The 8-bit resolve, eight pixels at a time; see resolve.h. Each lane performs
+// The 8-bit resolve, eight pixels at a time; see output8.h. Each lane performs
 // the scalar reference's float operations in the same order (tonemap.cpp's
-// operators, Srgb8Encoder's table walk), so the bytes are the same: the GCC
-// vector extension gives lane-wise IEEE arithmetic, and comparisons and
-// selects are written to treat NaN as the scalar code's if/else does.
+// operators) and encodes with Srgb8Encoder's byte thresholds (from a table of
+// its own), so the bytes are the same: the GCC vector extension gives
+// lane-wise IEEE arithmetic, and comparisons and selects are written to treat
+// NaN as the scalar code's if/else does.
 #include "shading/output8.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
@@ -90,8 +92,13 @@ inline void neutral(F8& r, F8& g, F8& b) {
     b = clamp01(b);
 }
 
-// Srgb8Encoder on eight lanes: the same coarse table and thresholds, walked
-// with gathers. `steps` is the most thresholds any bucket holds (1).
+// Srgb8Encoder on eight lanes with one gather per channel. A bucket of 2^16
+// floats spans under 0.7 of a byte step anywhere on the sRGB curve, so it
+// holds at most one threshold: its entry is the byte at its first float and
+// that threshold's offset into the bucket (2^16: none), and the byte is the
+// entry's plus one where the float's low bits reach the offset. The table
+// starts at the bucket of the first threshold (entry 0 stands for every
+// bucket below: byte 0), 6.6 KB, which stays in the L1 cache beside a tile.
 class Srgb8Lanes {
 public:
     static const Srgb8Lanes& instance() {
@@ -103,46 +110,45 @@ public:
         x = select(x > 1.0f, splat(1.0f), x);
         __m256i bits;
         std::memcpy(&bits, &x, sizeof bits);
-        const __m256i bucket = _mm256_srli_epi32(bits, kBucketShift);
-        __m256i b = _mm256_and_si256(
-            _mm256_i32gather_epi32(reinterpret_cast<const int*>(coarse_.data()), bucket, 1), _mm256_set1_epi32(0xFF));
-        for (int i = 0; i < steps_; ++i) {
-            const __m256i next = _mm256_i32gather_epi32(threshold_.data(), _mm256_add_epi32(b, _mm256_set1_epi32(1)), 4);
-            // bits >= next  <=>  !(next > bits); both below 2^31.
-            b = _mm256_sub_epi32(b, _mm256_andnot_si256(_mm256_cmpgt_epi32(next, bits), _mm256_set1_epi32(-1)));
-        }
-        return b;
+        const __m256i index = _mm256_max_epi32(
+            _mm256_sub_epi32(_mm256_srli_epi32(bits, kBucketShift), _mm256_set1_epi32(first_bucket_ - 1)),
+            _mm256_setzero_si256());
+        const __m256i entry = _mm256_i32gather_epi32(entry_.data(), index, 4);
+        const __m256i low = _mm256_and_si256(bits, _mm256_set1_epi32((1 << kBucketShift) - 1));
+        // byte + (low >= offset), as byte - (all ones where !(offset > low)).
+        const __m256i below = _mm256_cmpgt_epi32(_mm256_srli_epi32(entry, 8), low);
+        return _mm256_sub_epi32(_mm256_and_si256(entry, _mm256_set1_epi32(0xFF)),
+                                _mm256_andnot_si256(below, _mm256_set1_epi32(-1)));
     }
 
 private:
-    static constexpr int kBucketShift = 15;
+    static constexpr int kBucketShift = 16;
     static constexpr std::uint32_t kOneBits = 0x3F800000u;  // 1.0f
 
     Srgb8Lanes() {
         const Srgb8Encoder& enc = Srgb8Encoder::instance();
-        // threshold_[b] = the smallest bits encoding to b or more; index 256
-        // and bytes no float reaches get a value no input reaches.
-        threshold_.assign(257, 0x7FFFFFFF);
-        for (int b = 1; b < 256; ++b)
-            if (enc.threshold_bits(b) != 0xFFFFFFFFu) threshold_[std::size_t(b)] = int(enc.threshold_bits(b));
-        threshold_[0] = 0;
-        const int buckets = int(kOneBits >> kBucketShift) + 1;
-        coarse_.assign(std::size_t(buckets) + 4, 0);  // + 4: gathers read 4 bytes
-        int b = 0, most = 0;
-        for (int i = 0; i < buckets; ++i) {
+        // threshold[b] = the smallest bits encoding to b or more (b >= 1);
+        // bytes no float reaches get a value no input reaches.
+        std::vector<std::uint32_t> threshold(257, 0xFFFFFFFFu);
+        for (int b = 1; b < 256; ++b) threshold[std::size_t(b)] = enc.threshold_bits(b);
+        const int last = int(kOneBits >> kBucketShift);
+        first_bucket_ = int(threshold[1] >> kBucketShift);
+        entry_.assign(std::size_t(last - first_bucket_ + 2), 0);
+        entry_[0] = int(1u << (kBucketShift + 8));  // byte 0, no threshold
+        int b = 0;
+        for (int i = first_bucket_; i <= last; ++i) {
             const std::uint32_t start = std::uint32_t(i) << kBucketShift, end = start + (1u << kBucketShift);
-            while (b < 255 && std::uint32_t(threshold_[std::size_t(b) + 1]) <= start) ++b;
-            coarse_[std::size_t(i)] = std::uint8_t(b);
-            int inside = 0;
-            for (int k = b + 1; k <= 255 && std::uint32_t(threshold_[std::size_t(k)]) < end; ++k) ++inside;
-            most = inside > most ? inside : most;
+            while (b < 255 && threshold[std::size_t(b) + 1] <= start) ++b;
+            const std::uint32_t next = threshold[std::size_t(b) + 1];
+            // A second threshold inside the bucket would need a wider table.
+            if (next < end && threshold[std::size_t(b) + 2] < end) std::abort();
+            const std::uint32_t offset = next < end ? next - start : 1u << kBucketShift;
+            entry_[std::size_t(i - first_bucket_ + 1)] = int(std::uint32_t(b) | (offset << 8));
         }
-        steps_ = most;
     }
 
-    std::vector<std::uint8_t> coarse_;
-    std::vector<int> threshold_;
-    int steps_ = 1;
+    std::vector<int> entry_;
+    int first_bucket_ = 0;
 };
 
 inline void load8(const float* in, F8& r, F8& g, F8& b, F8& a) {
