@@ -22,7 +22,7 @@
 #include <cstdlib>
 
 #if defined(__SSE2__)
-#include <emmintrin.h>
+#include <immintrin.h>
 #endif
 #include <libdeflate.h>
 #include <png.h>
@@ -148,36 +148,72 @@ inline int paeth_predict(int a, int b, int c) {
 }
 
 #if defined(__SSE2__)
-// Paeth reconstruction of a row of BPP-byte pixels (3 or 4), one pixel per
-// step in 16-bit lanes: a (left), b (above), c (upper left).
+// Rows of BPP-byte pixels (3 or 4), one pixel per step in 16-bit lanes: a
+// (left), b (above), c (upper left), x (the filtered bytes). Each step waits
+// for the one before (a), so what counts is the chain from a to the result.
+inline __m128i load_pixel16(const unsigned char* p) {
+    std::int32_t word;
+    std::memcpy(&word, p, 4);
+    return _mm_unpacklo_epi8(_mm_cvtsi32_si128(word), _mm_setzero_si128());
+}
+template <int BPP> inline void store_pixel16(unsigned char* p, __m128i v) {
+    const std::int32_t word = _mm_cvtsi128_si32(_mm_packus_epi16(v, v));
+    std::memcpy(p, &word, BPP);
+}
+inline __m128i abs16(__m128i v) {
+#if defined(__SSSE3__)
+    return _mm_abs_epi16(v);
+#else
+    return _mm_max_epi16(v, _mm_sub_epi16(_mm_setzero_si128(), v));
+#endif
+}
+// mask ? t : f, the mask's lanes all ones or all zeros.
+inline __m128i select16(__m128i mask, __m128i t, __m128i f) {
+#if defined(__SSE4_1__)
+    return _mm_blendv_epi8(f, t, mask);
+#else
+    return _mm_or_si128(_mm_and_si128(mask, t), _mm_andnot_si128(mask, f));
+#endif
+}
+// Bytes in the low halves of 16-bit lanes (the high halves 0): x + p mod 256
+// in one add of bytes, whose carries stay inside each byte.
+inline __m128i add_mod256(__m128i x, __m128i p) { return _mm_add_epi8(x, p); }
+
+// Paeth (paeth_predict): a unless pa > min(pb, pc); then c if pb > pc, else b.
+// pa = |b - c| does not depend on a; from a the chain is a - c, the absolute
+// values, min, compare, select and the add: seven steps.
 template <int BPP>
 void paeth_sse2(const unsigned char* raw, const unsigned char* above, unsigned char* out, std::size_t n) {
-    const __m128i zero = _mm_setzero_si128();
-    __m128i a = zero, c = zero;
-    std::int32_t word;
+    __m128i a = _mm_setzero_si128(), c = a;
     for (std::size_t i = 0; i < n; i += BPP) {
-        std::memcpy(&word, above + i, 4);
-        const __m128i b = _mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero);
-        std::memcpy(&word, raw + i, 4);
-        const __m128i x = _mm_unpacklo_epi8(_mm_cvtsi32_si128(word), zero);
-        // pa = |b - c|, pb = |a - c|, pc = |a + b - 2c| (p = a + b - c).
-        const __m128i bc = _mm_sub_epi16(b, c), ac = _mm_sub_epi16(a, c);
-        const __m128i abc = _mm_add_epi16(bc, ac);
-        const __m128i pa = _mm_max_epi16(bc, _mm_sub_epi16(zero, bc));
-        const __m128i pb = _mm_max_epi16(ac, _mm_sub_epi16(zero, ac));
-        const __m128i pc = _mm_max_epi16(abc, _mm_sub_epi16(zero, abc));
-        // a if pa is the smallest, else b if pb is, else c (ties in that order).
-        const __m128i smallest = _mm_min_epi16(pc, _mm_min_epi16(pa, pb));
-        const __m128i use_a = _mm_cmpeq_epi16(pa, smallest);
-        const __m128i use_b = _mm_andnot_si128(use_a, _mm_cmpeq_epi16(pb, smallest));
-        const __m128i use_c = _mm_andnot_si128(_mm_or_si128(use_a, use_b), _mm_set1_epi16(-1));
-        const __m128i pred = _mm_or_si128(_mm_or_si128(_mm_and_si128(use_a, a), _mm_and_si128(use_b, b)),
-                                          _mm_and_si128(use_c, c));
-        const __m128i value = _mm_and_si128(_mm_add_epi16(x, pred), _mm_set1_epi16(0xFF));
-        word = _mm_cvtsi128_si32(_mm_packus_epi16(value, zero));
-        std::memcpy(out + i, &word, BPP);
-        a = value;
+        const __m128i b = load_pixel16(above + i), x = load_pixel16(raw + i);
+        const __m128i bc = _mm_sub_epi16(b, c), pa = abs16(bc);
+        const __m128i ac = _mm_sub_epi16(a, c);
+        const __m128i pb = abs16(ac), pc = abs16(_mm_add_epi16(ac, bc));  // |a + b - 2c|
+        const __m128i not_a = _mm_cmpgt_epi16(pa, _mm_min_epi16(pb, pc));
+        const __m128i b_or_c = select16(_mm_cmpgt_epi16(pb, pc), c, b);
+        a = add_mod256(x, select16(not_a, b_or_c, a));
+        store_pixel16<BPP>(out + i, a);
         c = b;
+    }
+}
+
+// Sub (x + a) and Average (x + (a + b) / 2, b = 0 without a row above).
+template <int BPP>
+void sub_sse2(const unsigned char* raw, unsigned char* out, std::size_t n) {
+    __m128i a = _mm_setzero_si128();
+    for (std::size_t i = 0; i < n; i += BPP) {
+        a = add_mod256(load_pixel16(raw + i), a);
+        store_pixel16<BPP>(out + i, a);
+    }
+}
+template <int BPP>
+void average_sse2(const unsigned char* raw, const unsigned char* above, unsigned char* out, std::size_t n) {
+    __m128i a = _mm_setzero_si128();
+    for (std::size_t i = 0; i < n; i += BPP) {
+        const __m128i b = above ? load_pixel16(above + i) : _mm_setzero_si128();
+        a = add_mod256(load_pixel16(raw + i), _mm_srli_epi16(_mm_add_epi16(a, b), 1));
+        store_pixel16<BPP>(out + i, a);
     }
 }
 #endif
@@ -191,6 +227,10 @@ bool unfilter_row(int filter, const unsigned char* raw, const unsigned char* abo
     switch (filter) {
     case 0: std::memcpy(out, raw, n); return true;
     case 1:
+#if defined(__SSE2__)
+        if (bpp == 3) return sub_sse2<3>(raw, out, n), true;
+        if (bpp == 4) return sub_sse2<4>(raw, out, n), true;
+#endif
         for (std::size_t i = 0; i < n; ++i) out[i] = (unsigned char)(raw[i] + (i >= b ? out[i - b] : 0));
         return true;
     case 2:
@@ -198,6 +238,10 @@ bool unfilter_row(int filter, const unsigned char* raw, const unsigned char* abo
         else for (std::size_t i = 0; i < n; ++i) out[i] = (unsigned char)(raw[i] + above[i]);
         return true;
     case 3:
+#if defined(__SSE2__)
+        if (bpp == 3) return average_sse2<3>(raw, above, out, n), true;
+        if (bpp == 4) return average_sse2<4>(raw, above, out, n), true;
+#endif
         for (std::size_t i = 0; i < n; ++i)
             out[i] = (unsigned char)(raw[i] + (((i >= b ? out[i - b] : 0) + (above ? above[i] : 0)) >> 1));
         return true;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <png.h>
+#include <zlib.h>
 #include <stb_image.h>
 
 #include "fuzz/png_craft.h"
@@ -31,8 +32,11 @@ struct Flavour {
     bool trns, interlace;
 };
 
-// Writes a w x h PNG of one flavour, with packed samples from `rng`.
-std::vector<unsigned char> write_flavour(const Flavour& f, int w, int h, std::mt19937& rng) {
+// Writes a w x h PNG of one flavour, with packed samples from `rng`; with
+// `filters` >= 0 (PNG_FILTER_NONE ... PNG_FILTER_PAETH, or several) libpng
+// filters its rows with those only, and the samples are gradients, flat runs
+// and noise by turns (so that Paeth picks each of its three neighbours).
+std::vector<unsigned char> write_flavour(const Flavour& f, int w, int h, std::mt19937& rng, int filters = -1) {
     std::vector<unsigned char> out;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
     png_infop info = png_create_info_struct(png);
@@ -56,6 +60,7 @@ std::vector<unsigned char> write_flavour(const Flavour& f, int w, int h, std::mt
         key.red = 3; key.green = 5; key.blue = 7;
         png_set_tRNS(png, info, nullptr, 0, &key);
     }
+    if (filters >= 0) png_set_filter(png, PNG_FILTER_TYPE_BASE, filters);
     png_write_info(png, info);
     const int channels = f.colour_type == PNG_COLOR_TYPE_RGB ? 3 : f.colour_type == PNG_COLOR_TYPE_RGBA ? 4
                          : f.colour_type == PNG_COLOR_TYPE_GRAY_ALPHA ? 2 : 1;
@@ -63,9 +68,16 @@ std::vector<unsigned char> write_flavour(const Flavour& f, int w, int h, std::mt
     std::vector<std::vector<png_byte>> rows;
     rows.assign(static_cast<std::size_t>(h), std::vector<png_byte>(row_bytes));
     const int max_index = f.colour_type == PNG_COLOR_TYPE_PALETTE ? 15 : (1 << f.bit_depth) - 1;
-    for (auto& row : rows) {
+    for (std::size_t y = 0; y < rows.size(); ++y) {
+        std::vector<png_byte>& row = rows[y];
         // Small values often, so that the tRNS keys are hit.
         for (png_byte& b : row) b = png_byte(rng() % 4 == 0 ? 0x13 : rng());
+        if (filters >= 0)
+            for (std::size_t i = 0; i < row.size(); ++i) {
+                const std::size_t part = (i * 5 / row.size() + y) % 3;
+                if (part == 0) row[i] = png_byte(3 * i + 7 * y);  // gradients across and down
+                else if (part == 1) row[i] = png_byte(200 - (i % 3) * 40);
+            }
         // 4-bit palette indices are all below 16, the palette's size; 8-bit ones are folded.
         if (f.bit_depth == 8 && f.colour_type == PNG_COLOR_TYPE_PALETTE)
             for (png_byte& b : row) b = png_byte(b % (max_index + 1));
@@ -154,6 +166,51 @@ TEST_CASE("PNG image data: libdeflate's whole-image inflate and zlib's rows give
         });
         CHECK_THROWS_WITH(decode(damaged), doctest::Contains("p.png: cannot decode PNG image: corrupt image data"));
     }
+}
+
+TEST_CASE("every row filter, at 1 to 4 bytes a pixel, unfilters exactly as stb_image does") {
+    const Flavour flavours[] = {{"grey", PNG_COLOR_TYPE_GRAY, 8, false, false},
+                                {"grey+alpha", PNG_COLOR_TYPE_GRAY_ALPHA, 8, false, false},
+                                {"RGB", PNG_COLOR_TYPE_RGB, 8, false, false},
+                                {"RGBA", PNG_COLOR_TYPE_RGBA, 8, false, false}};
+    const int filters[] = {PNG_FILTER_NONE, PNG_FILTER_SUB, PNG_FILTER_UP, PNG_FILTER_AVG, PNG_FILTER_PAETH,
+                           PNG_ALL_FILTERS};
+    std::mt19937 rng(17u);
+    int paeth_rows = 0;
+    for (const Flavour& f : flavours)
+        for (int filter : filters)
+            for (int size : {1, 2, 5, 64, 301}) {
+                INFO(std::string(f.name), " filters ", filter, " ", size, "x", size / 2 + 3);
+                const std::vector<unsigned char> png = write_flavour(f, size, size / 2 + 3, rng, filter);
+                // The rows carry the filter asked for (libpng may write None on the first row).
+                const std::vector<unsigned char> stream = [&] {
+                    std::vector<unsigned char> s;
+                    restream(png, 1u << 20, [&](const std::vector<unsigned char>& z) {
+                        s = z;
+                        return z;
+                    });
+                    return s;
+                }();
+                int w = 0, h = 0, comp = 0;
+                stbi_uc* ref = stbi_load_from_memory(png.data(), int(png.size()), &w, &h, &comp, 0);
+                REQUIRE(ref != nullptr);
+                if (filter == PNG_FILTER_PAETH && h > 1) {
+                    std::vector<unsigned char> raw(std::size_t(w * comp + 1) * std::size_t(h));
+                    uLongf raw_size = uLongf(raw.size());
+                    REQUIRE(uncompress(raw.data(), &raw_size, stream.data(), uLong(stream.size())) == Z_OK);
+                    for (int y = 1; y < h; ++y) paeth_rows += raw[std::size_t(y) * std::size_t(w * comp + 1)] == 4;
+                }
+                ImageSource src;
+                src.bytes = png;
+                src.name = f.name;
+                const Image img = decode_image(src, false);
+                REQUIRE(img.width == w);
+                REQUIRE(img.height == h);
+                CHECK(img.channels == comp);
+                CHECK(img.pixels == std::vector<std::uint8_t>(ref, ref + std::size_t(w) * std::size_t(h) * std::size_t(comp)));
+                stbi_image_free(ref);
+            }
+    CHECK(paeth_rows > 100);  // the Paeth rows were written as Paeth
 }
 
 TEST_CASE("libpng decodes every 8-bit PNG flavour exactly as stb_image does") {
