@@ -27,6 +27,7 @@
 #include <thread>
 #include <vector>
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <glm/glm.hpp>
@@ -669,6 +670,13 @@ int run(int argc, char** argv) {
 } // namespace
 
 int main(int argc, char** argv) {
+#ifdef M_MMAP_THRESHOLD
+    // One render, then exit: a decoder's large scratch buffers (inflated PNG
+    // rows, decoded pixels), once freed, serve the next image from the heap
+    // instead of being unmapped and faulted in (and zeroed) afresh.
+    mallopt(M_MMAP_THRESHOLD, 256 << 20);
+    mallopt(M_TRIM_THRESHOLD, 512 << 20);
+#endif
     // Never crash: whatever escapes is one line and exit code 1.
     try {
         return run(argc, argv);
