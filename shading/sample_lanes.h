@@ -410,13 +410,35 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
 // Blocks with at most this many live lanes read them one by one.
 constexpr int kSparseLanes = 4;
 
+#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+// fetch_unorm8_lanes<16, 16, C> for a texture's channel count, compiled for
+// AVX-512 alone (shading/sample_lanes_avx512.cpp) and called only when the
+// CPU has it: the same integers and floats per lane as eight at a time.
+void fetch_unorm8_lanes16_avx512(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components);
+// The CPU runs AVX-512 (F, BW, DQ, VL) and PRAST_AVX512 is not 0 in the
+// environment; read once.
+bool use_avx512();
+#endif
+
 template <int N>
 inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
+#ifdef PRAST_SIMD16
+    constexpr int W = N >= 16 ? 16 : (N >= 8 ? 8 : 4);
+#else
     constexpr int W = N >= 8 ? 8 : 4;
+#endif
     if (__builtin_popcount(at.live) <= kSparseLanes) {
         fetch_fix_one_by_one<N>(tex, at, out);  // any channel count
         return;
     }
+#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+    if constexpr (N == 16) {
+        if (use_avx512()) {
+            fetch_unorm8_lanes16_avx512(tex, at, out, components);
+            return;
+        }
+    }
+#endif
     switch (tex.channels()) {
     case 1: fetch_unorm8_lanes<N, W, 1>(tex, at, out, components); return;
     case 2: fetch_unorm8_lanes<N, W, 2>(tex, at, out, components); return;

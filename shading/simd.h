@@ -1,5 +1,5 @@
 // W float or int32 lanes per instruction under AVX2: Simd<8> (ymm) and
-// Simd<4> (xmm) with the same member names, so a lane loop is written once
+// Simd<4> (xmm), and Simd<16> (zmm) under AVX-512, with the same member names, so a lane loop is written once
 // and instantiated for whole blocks and for packed sparse ones
 // (sample_lanes.h texture fetches, shadow_lanes.h PCF).
 #pragma once
@@ -126,6 +126,72 @@ private:
         return _mm_castps_si128(_mm_shuffle_ps(lo, hi, _MM_SHUFFLE(2, 0, 2, 0)));
     }
 };
+
+#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512DQ__)
+#define PRAST_SIMD16 1
+// 16 lanes (zmm) for x86-64-v4 builds: a whole 4x4 block per instruction.
+// Comparisons give vector masks (all ones or zeros per lane) as the narrower
+// widths do, turned into AVX-512 mask registers where an instruction takes one.
+// The gathers are the masked forms with a zero source (GCC 12's unmasked ones
+// read an undefined register, which -Wmaybe-uninitialized reports).
+template <> struct Simd<16> {
+    using F = __m512;
+    using I = __m512i;
+    static I load_i(const std::int32_t* p) { return _mm512_load_si512(p); }
+    static F load_f(const float* p) { return _mm512_load_ps(p); }
+    static void store_f(float* p, F v) { _mm512_store_ps(p, v); }
+    static I set1_i(int v) { return _mm512_set1_epi32(v); }
+    static F set1_f(float v) { return _mm512_set1_ps(v); }
+    static F zero_f() { return _mm512_setzero_ps(); }
+    static I lane_bits() {
+        return _mm512_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384, 32768);
+    }
+    template <int Scale> static I gather_i(const std::uint8_t* base, I idx) {
+        return _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), 0xFFFF, idx, base, Scale);
+    }
+    static F gather_f(const float* table, I idx) {
+        return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), 0xFFFF, idx, table, 4);
+    }
+    // As Simd<8>::gather_q: eight qwords per gather, in lane order.
+    template <int Scale, int Shift> static void gather_q(const std::uint8_t* base, I idx, I& low, I& shifted) {
+        const I a = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_castsi512_si256(idx), base, Scale);
+        const I b = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_extracti64x4_epi64(idx, 1), base, Scale);
+        low = join(_mm512_cvtepi64_epi32(a), _mm512_cvtepi64_epi32(b));
+        shifted = join(_mm512_cvtepi64_epi32(_mm512_srli_epi64(a, Shift)), _mm512_cvtepi64_epi32(_mm512_srli_epi64(b, Shift)));
+    }
+    static I add_i(I a, I b) { return _mm512_add_epi32(a, b); }
+    static I sub_i(I a, I b) { return _mm512_sub_epi32(a, b); }
+    static I and_i(I a, I b) { return _mm512_and_si512(a, b); }
+    static I or_i(I a, I b) { return _mm512_or_si512(a, b); }
+    // The zero-masked forms of the shifts: GCC 12's plain ones pass an undefined
+    // register to their builtin (the same false -Wmaybe-uninitialized).
+    template <int N> static I slli_i(I a) { return _mm512_maskz_slli_epi32(0xFFFF, a, N); }
+    template <int N> static I srli_i(I a) { return _mm512_maskz_srli_epi32(0xFFFF, a, N); }
+    static I madd_i(I a, I b) { return _mm512_madd_epi16(a, b); }
+    static I cvtt(F a) { return _mm512_cvttps_epi32(a); }
+    static I select_i(I mask, I yes, I no) { return _mm512_mask_blend_epi32(_mm512_movepi32_mask(mask), no, yes); }
+    static I srlv_i(I a, I n) { return _mm512_maskz_srlv_epi32(0xFFFF, a, n); }
+    static I cmpeq_i(I a, I b) { return _mm512_movm_epi32(_mm512_cmpeq_epi32_mask(a, b)); }
+    static F cvt(I a) { return _mm512_cvtepi32_ps(a); }
+    static F add(F a, F b) { return _mm512_add_ps(a, b); }
+    static F sub(F a, F b) { return _mm512_sub_ps(a, b); }
+    static F mul(F a, F b) { return _mm512_mul_ps(a, b); }
+    static F div(F a, F b) { return _mm512_div_ps(a, b); }
+    static F select(F mask, F yes, F no) {
+        return _mm512_mask_blend_ps(_mm512_movepi32_mask(_mm512_castps_si512(mask)), no, yes);
+    }
+    static F as_f(I a) { return _mm512_castsi512_ps(a); }
+    static F and_f(F a, F b) { return _mm512_and_ps(a, b); }
+    static F or_f(F a, F b) { return _mm512_or_ps(a, b); }
+    static F cmpge(F a, F b) { return _mm512_castsi512_ps(_mm512_movm_epi32(_mm512_cmp_ps_mask(a, b, _CMP_GE_OQ))); }
+    static F cmplt(F a, F b) { return _mm512_castsi512_ps(_mm512_movm_epi32(_mm512_cmp_ps_mask(a, b, _CMP_LT_OQ))); }
+    static bool all(F mask) { return _mm512_movepi32_mask(_mm512_castps_si512(mask)) == 0xFFFF; }
+    static bool all_i(I mask) { return _mm512_movepi32_mask(mask) == 0xFFFF; }
+
+private:
+    static I join(__m256i lo, __m256i hi) { return _mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1); }
+};
+#endif
 
 } // namespace prast
 

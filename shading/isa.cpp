@@ -1,0 +1,24 @@
+// Run-time choice of the AVX-512 block fetch (sample_lanes.h), compiled for
+// the build's own ISA so that it runs on any CPU.
+#include "shading/sample_lanes.h"
+
+#include <cstdlib>
+#include <cstring>
+
+namespace prast::sample_lanes_detail {
+
+#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+bool use_avx512() {
+    static const bool use = [] {
+        const char* env = std::getenv("PRAST_AVX512");
+        if (env && std::strcmp(env, "0") == 0) return false;
+        // libgcc's check includes the OS saving the AVX-512 registers (XCR0).
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+               __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
+    }();
+    return use;
+}
+#endif
+
+} // namespace prast::sample_lanes_detail

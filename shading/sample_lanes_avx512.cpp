@@ -1,0 +1,32 @@
+// The 8-bit block fetch sixteen lanes at a time, for AVX2 builds on CPUs
+// with AVX-512 (sample_lanes.h chooses at run time). This file alone is
+// compiled with -mavx512f/bw/dq/vl: everything it instantiates is a template
+// on Simd<16>, which no other file instantiates, so no inline function
+// compiled here can stand in for another file's copy on a CPU without
+// AVX-512 (the `isa` test lists this object's symbols to keep it so).
+// GCC 12's AVX-512 intrinsics pass an undefined register to their builtins,
+// which -Wmaybe-uninitialized reports wherever they are inlined (GCC bug 105593).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+#include "shading/sample_lanes.h"
+
+#include <cstdlib>
+#include <cstring>
+
+#if !defined(PRAST_SIMD16)
+#error "sample_lanes_avx512.cpp needs AVX-512 F, BW and DQ (see shading/CMakeLists.txt)"
+#endif
+
+namespace prast::sample_lanes_detail {
+
+void fetch_unorm8_lanes16_avx512(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
+    switch (tex.channels()) {
+    case 1: fetch_unorm8_lanes<16, 16, 1>(tex, at, out, components); return;
+    case 2: fetch_unorm8_lanes<16, 16, 2>(tex, at, out, components); return;
+    case 3: fetch_unorm8_lanes<16, 16, 3>(tex, at, out, components); return;
+    default: fetch_unorm8_lanes<16, 16, 4>(tex, at, out, components); return;
+    }
+}
+
+} // namespace prast::sample_lanes_detail
