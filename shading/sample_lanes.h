@@ -24,6 +24,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 #include <glm/glm.hpp>
 
@@ -75,12 +76,32 @@ namespace sample_lanes_detail {
 
 constexpr int kMaxN = kBlockLanes;
 
+// Tags for the instruction set the lane loops are instantiated for: a copy
+// compiled for AVX-512 must not share a name with the default one (the
+// linker would keep either).
+struct IsaDefault {};
+struct IsaAvx512 {};
+
+#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+// Sixteen lanes compiled for AVX-512 alone (shading/sample_lanes_avx512.cpp)
+// and called only when the CPU has it: the same integers and floats per
+// lane as the default code. fetch_unorm8_lanes<16, 16, C> for the texture's
+// channel count, and prepare_trilinear_lanes<16, IsaAvx512>.
+void fetch_unorm8_lanes16_avx512(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components);
+void prepare_trilinear_lanes16_avx512(const Texture& tex, const float* u, const float* v, const float* lambda,
+                                      const std::uint8_t* quad, std::uint32_t live, TrilinearLanes& out);
+// The CPU runs AVX-512 (F, BW, DQ, VL) and PRAST_AVX512 is not 0 in the
+// environment; read once.
+bool use_avx512();
+#endif
+
 // One mip level per lane (its quad's).
 struct LevelLanes {
     alignas(64) float fw[kMaxN], fh[kMaxN];
     alignas(64) std::int32_t w[kMaxN], h[kMaxN], offset[kMaxN];
 
     // Lanes [begin, end) read `level`.
+    template <class Isa = IsaDefault>
     void set(const Texture& tex, int level, int begin, int end) {
         const std::int32_t lw = tex.width(level), lh = tex.height(level);
         const std::int32_t loff = std::int32_t(tex.level_offset(level));
@@ -93,7 +114,7 @@ struct LevelLanes {
 };
 
 // Texture::bilinear_reduced() up to the texel indices, for the first N lanes.
-template <int N, Wrap S, Wrap T>
+template <int N, Wrap S, Wrap T, class Isa = IsaDefault>
 inline void bilinear_indices(const float* __restrict ur, const float* __restrict vr,
                              const LevelLanes& __restrict L, std::int32_t (*__restrict idx)[kMaxN],
                              float* __restrict tx, float* __restrict ty) {
@@ -116,7 +137,7 @@ inline void bilinear_indices(const float* __restrict ur, const float* __restrict
 
 // Texture::nearest_reduced() up to the texel index, for the lanes in `lanes`
 // (the others keep their bilinear indices and weights).
-template <int N, Wrap S, Wrap T>
+template <int N, Wrap S, Wrap T, class Isa = IsaDefault>
 inline void nearest_indices(const float* __restrict ur, const float* __restrict vr, const LevelLanes& __restrict L,
                             std::uint32_t lanes, std::int32_t (*__restrict idx)[kMaxN], float* __restrict tx,
                             float* __restrict ty) {
@@ -130,7 +151,7 @@ inline void nearest_indices(const float* __restrict ur, const float* __restrict 
     }
 }
 
-template <int N, Wrap S, Wrap T>
+template <int N, Wrap S, Wrap T, class Isa>
 inline void prepare(const float* __restrict u, const float* __restrict v, const LevelLanes& A,
                     const LevelLanes* B, TrilinearLanes& out) {
     alignas(64) float ur[kMaxN], vr[kMaxN];
@@ -138,21 +159,21 @@ inline void prepare(const float* __restrict u, const float* __restrict v, const 
         ur[l] = texture_detail::reduce<S>(u[l]);
         vr[l] = texture_detail::reduce<T>(v[l]);
     }
-    bilinear_indices<N, S, T>(ur, vr, A, out.ia, out.txa, out.tya);
-    if (B) bilinear_indices<N, S, T>(ur, vr, *B, out.ib, out.txb, out.tyb);
+    bilinear_indices<N, S, T, Isa>(ur, vr, A, out.ia, out.txa, out.tya);
+    if (B) bilinear_indices<N, S, T, Isa>(ur, vr, *B, out.ib, out.txb, out.tyb);
     if (out.nearest) {
-        nearest_indices<N, S, T>(ur, vr, A, out.nearest, out.ia, out.txa, out.tya);
-        if (B) nearest_indices<N, S, T>(ur, vr, *B, out.nearest, out.ib, out.txb, out.tyb);
+        nearest_indices<N, S, T, Isa>(ur, vr, A, out.nearest, out.ia, out.txa, out.tya);
+        if (B) nearest_indices<N, S, T, Isa>(ur, vr, *B, out.nearest, out.ib, out.txb, out.tyb);
     }
 }
 
-template <int N, Wrap S>
+template <int N, Wrap S, class Isa>
 inline void prepare_s(Wrap t, const float* u, const float* v, const LevelLanes& A, const LevelLanes* B,
                       TrilinearLanes& out) {
     switch (t) {
-    case Wrap::Repeat: prepare<N, S, Wrap::Repeat>(u, v, A, B, out); return;
-    case Wrap::ClampToEdge: prepare<N, S, Wrap::ClampToEdge>(u, v, A, B, out); return;
-    case Wrap::MirroredRepeat: prepare<N, S, Wrap::MirroredRepeat>(u, v, A, B, out); return;
+    case Wrap::Repeat: prepare<N, S, Wrap::Repeat, Isa>(u, v, A, B, out); return;
+    case Wrap::ClampToEdge: prepare<N, S, Wrap::ClampToEdge, Isa>(u, v, A, B, out); return;
+    case Wrap::MirroredRepeat: prepare<N, S, Wrap::MirroredRepeat, Isa>(u, v, A, B, out); return;
     }
 }
 
@@ -410,15 +431,6 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
 // Blocks with at most this many live lanes read them one by one.
 constexpr int kSparseLanes = 4;
 
-#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
-// fetch_unorm8_lanes<16, 16, C> for a texture's channel count, compiled for
-// AVX-512 alone (shading/sample_lanes_avx512.cpp) and called only when the
-// CPU has it: the same integers and floats per lane as eight at a time.
-void fetch_unorm8_lanes16_avx512(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components);
-// The CPU runs AVX-512 (F, BW, DQ, VL) and PRAST_AVX512 is not 0 in the
-// environment; read once.
-bool use_avx512();
-#endif
 
 template <int N>
 inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
@@ -458,11 +470,19 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
 // blocks first) and quad[l] < kMaxQuadSlots names lane l's quad. Only the
 // lanes in `live` are fetched later, but every lane gets valid indices
 // (reduce() folds any coordinate).
-template <int N = kBlockLanes>
+template <int N = kBlockLanes, class Isa = sample_lanes_detail::IsaDefault>
 inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const float* v, const float* lambda,
                                     const std::uint8_t* quad, std::uint32_t live, TrilinearLanes& out) {
     using namespace sample_lanes_detail;
     static_assert(N % 4 == 0 && N <= kMaxN, "whole vectors of lanes");
+#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+    if constexpr (N == 16 && std::is_same_v<Isa, IsaDefault>) {
+        if (use_avx512()) {
+            prepare_trilinear_lanes16_avx512(tex, u, v, lambda, quad, live, out);
+            return;
+        }
+    }
+#endif
     const bool unpacked = !quad;
     auto quad_of = [quad](int l) { return quad ? int(quad[l]) : l >> 2; };
 
@@ -533,28 +553,28 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
     }
     LevelLanes A, B;
     if (uniform) {
-        A.set(tex, la[q0], 0, N);
+        A.template set<Isa>(tex, la[q0], 0, N);
     } else if (unpacked) {
-        for (int q = 0; q < 4; ++q) A.set(tex, la[q], 4 * q, 4 * q + 4);
+        for (int q = 0; q < 4; ++q) A.template set<Isa>(tex, la[q], 4 * q, 4 * q + 4);
     } else {
-        for (int l = 0; l < N; ++l) A.set(tex, la[quad_of(l)], l, l + 1);
+        for (int l = 0; l < N; ++l) A.template set<Isa>(tex, la[quad_of(l)], l, l + 1);
     }
     const LevelLanes* b = nullptr;
     if (out.blend) {
         // Lanes that do not blend get level A again (never read).
         if (uniform) {
-            B.set(tex, la[q0] + 1, 0, N);
+            B.template set<Isa>(tex, la[q0] + 1, 0, N);
         } else if (unpacked) {
-            for (int q = 0; q < 4; ++q) B.set(tex, la[q] + ((blend_quads >> q) & 1u), 4 * q, 4 * q + 4);
+            for (int q = 0; q < 4; ++q) B.template set<Isa>(tex, la[q] + ((blend_quads >> q) & 1u), 4 * q, 4 * q + 4);
         } else {
-            for (int l = 0; l < N; ++l) B.set(tex, la[quad_of(l)] + ((blend_quads >> quad_of(l)) & 1u), l, l + 1);
+            for (int l = 0; l < N; ++l) B.template set<Isa>(tex, la[quad_of(l)] + ((blend_quads >> quad_of(l)) & 1u), l, l + 1);
         }
         b = &B;
     }
     switch (tex.wrap_s()) {
-    case Wrap::Repeat: prepare_s<N, Wrap::Repeat>(tex.wrap_t(), u, v, A, b, out); return;
-    case Wrap::ClampToEdge: prepare_s<N, Wrap::ClampToEdge>(tex.wrap_t(), u, v, A, b, out); return;
-    case Wrap::MirroredRepeat: prepare_s<N, Wrap::MirroredRepeat>(tex.wrap_t(), u, v, A, b, out); return;
+    case Wrap::Repeat: prepare_s<N, Wrap::Repeat, Isa>(tex.wrap_t(), u, v, A, b, out); return;
+    case Wrap::ClampToEdge: prepare_s<N, Wrap::ClampToEdge, Isa>(tex.wrap_t(), u, v, A, b, out); return;
+    case Wrap::MirroredRepeat: prepare_s<N, Wrap::MirroredRepeat, Isa>(tex.wrap_t(), u, v, A, b, out); return;
     }
 }
 

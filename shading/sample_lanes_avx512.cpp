@@ -1,9 +1,10 @@
-// The 8-bit block fetch sixteen lanes at a time, for AVX2 builds on CPUs
-// with AVX-512 (sample_lanes.h chooses at run time). This file alone is
-// compiled with -mavx512f/bw/dq/vl: everything it instantiates is a template
-// on Simd<16>, which no other file instantiates, so no inline function
-// compiled here can stand in for another file's copy on a CPU without
-// AVX-512 (the `isa` test lists this object's symbols to keep it so).
+// The 8-bit block fetch sixteen lanes at a time, and the preparation of the
+// lanes' texel indices, for AVX2 builds on CPUs with AVX-512 (sample_lanes.h
+// chooses at run time). This file alone is compiled with -mavx512f/bw/dq/vl:
+// everything it instantiates is a template on Simd<16> or tagged IsaAvx512,
+// which no other file instantiates, so no inline function compiled here can
+// stand in for another file's copy on a CPU without AVX-512 (the `isa` test
+// lists this object's symbols to keep it so).
 // GCC 12's AVX-512 intrinsics pass an undefined register to their builtins,
 // which -Wmaybe-uninitialized reports wherever they are inlined (GCC bug 105593).
 #if defined(__GNUC__) && !defined(__clang__)
@@ -27,6 +28,11 @@ void fetch_unorm8_lanes16_avx512(const Texture& tex, const TrilinearLanes& at, T
     case 3: fetch_unorm8_lanes<16, 16, 3>(tex, at, out, components); return;
     default: fetch_unorm8_lanes<16, 16, 4>(tex, at, out, components); return;
     }
+}
+
+void prepare_trilinear_lanes16_avx512(const Texture& tex, const float* u, const float* v, const float* lambda,
+                                      const std::uint8_t* quad, std::uint32_t live, TrilinearLanes& out) {
+    prepare_trilinear_lanes<16, IsaAvx512>(tex, u, v, lambda, quad, live, out);
 }
 
 } // namespace prast::sample_lanes_detail
