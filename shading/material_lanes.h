@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 #include "raster/limits.h"
 #include "shading/light_block.h"
@@ -48,7 +49,7 @@ struct SurfaceLanes {
 namespace material_lanes_detail {
 
 // safe_normalize(v, fallback) of surface.h, per lane.
-template <int N>
+template <int N, class Isa = sample_lanes_detail::IsaDefault>
 [[gnu::always_inline]] inline void safe_normalize_lanes(float* __restrict x, float* __restrict y,
                                                         float* __restrict z, const float* __restrict fx,
                                                         const float* __restrict fy, const float* __restrict fz) {
@@ -62,18 +63,30 @@ template <int N>
     }
 }
 
-template <int N>
+template <int N, class Isa = sample_lanes_detail::IsaDefault>
 inline void copy_lanes(float* dst, const float* src) { std::memcpy(dst, src, sizeof(float) * N); }
 
 } // namespace material_lanes_detail
 
 // Fills the first N lanes of mb for the lanes in `live` (the others get
 // values nobody reads) and returns the live lanes an alpha MASK discards.
-template <int N = kBlockLanes>
+#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+// sample_material_lanes<16, IsaAvx512>, compiled for AVX-512 alone
+// (shading/sample_lanes_avx512.cpp) and called only when the CPU has it.
+std::uint32_t sample_material_lanes16_avx512(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
+                                             MaterialBlock& mb);
+#endif
+
+template <int N = kBlockLanes, class Isa = sample_lanes_detail::IsaDefault>
 inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
                                            MaterialBlock& mb) {
     using namespace material_lanes_detail;
     static_assert(N % 4 == 0 && N <= kBlockLanes, "whole vectors of lanes");
+#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+    if constexpr (N == 16 && std::is_same_v<Isa, sample_lanes_detail::IsaDefault>) {
+        if (sample_lanes_detail::use_avx512()) return sample_material_lanes16_avx512(bm, s, live, mb);
+    }
+#endif
     const Material& m = *bm.m;
 
     // Look up every bound texture, the components that are used only (bit 0
@@ -188,8 +201,8 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
                 }
             }
             TrilinearLanes at;
-            prepare_trilinear_lanes<N>(first, u, v, lambda, s.quad, live, at);
-            fetch_trilinear_lanes<N>(group_tex[g], group_size[g], at, group_out[g], group_used[g]);
+            prepare_trilinear_lanes<N, Isa>(first, u, v, lambda, s.quad, live, at);
+            fetch_trilinear_lanes<N, Isa>(group_tex[g], group_size[g], at, group_out[g], group_used[g]);
         }
     }
 
@@ -266,13 +279,13 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
 
     // Geometric frame; a back face of a double-sided material flips all of it.
     alignas(64) float Nx[N], Ny[N], Nz[N], zero[N], one[N], flip[N];
-    copy_lanes<N>(Nx, s.Nx); copy_lanes<N>(Ny, s.Ny); copy_lanes<N>(Nz, s.Nz);
+    copy_lanes<N, Isa>(Nx, s.Nx); copy_lanes<N, Isa>(Ny, s.Ny); copy_lanes<N, Isa>(Nz, s.Nz);
     for (int l = 0; l < N; ++l) {
         zero[l] = 0.0f;
         one[l] = 1.0f;
         flip[l] = ((s.back_facing >> l) & 1u) ? -1.0f : 1.0f;
     }
-    safe_normalize_lanes<N>(Nx, Ny, Nz, zero, zero, one);
+    safe_normalize_lanes<N, Isa>(Nx, Ny, Nz, zero, zero, one);
     for (int l = 0; l < N; ++l) {
         mb.Nx[l] = Nx[l] * flip[l]; mb.Ny[l] = Ny[l] * flip[l]; mb.Nz[l] = Nz[l] * flip[l];
         mb.Gx[l] = mb.Nx[l]; mb.Gy[l] = mb.Ny[l]; mb.Gz[l] = mb.Nz[l];
@@ -292,8 +305,8 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
             nty[l] = (tex.g[l] * 2.0f - 1.0f) * scale;
             ntz[l] = tex.b[l] * 2.0f - 1.0f;
         }
-        safe_normalize_lanes<N>(Tx, Ty, Tz, zero, zero, zero);
-        safe_normalize_lanes<N>(ntx, nty, ntz, zero, zero, one);
+        safe_normalize_lanes<N, Isa>(Tx, Ty, Tz, zero, zero, zero);
+        safe_normalize_lanes<N, Isa>(ntx, nty, ntz, zero, zero, one);
         alignas(64) float mapped[N];  // 1 where the tangent frame exists
         for (int l = 0; l < N; ++l) {
             mapped[l] = Tx[l] * Tx[l] + Ty[l] * Ty[l] + Tz[l] * Tz[l] > 0.0f ? 1.0f : 0.0f;
@@ -305,7 +318,7 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
             ny[l] = Ty[l] * ntx[l] + By * nty[l] + Ny[l] * ntz[l];
             nz[l] = Tz[l] * ntx[l] + Bz * nty[l] + Nz[l] * ntz[l];
         }
-        safe_normalize_lanes<N>(nx, ny, nz, Nx, Ny, Nz);
+        safe_normalize_lanes<N, Isa>(nx, ny, nz, Nx, Ny, Nz);
         for (int l = 0; l < N; ++l) {
             const bool use = mapped[l] != 0.0f;
             mb.Nx[l] = use ? nx[l] * flip[l] : mb.Nx[l];
@@ -314,9 +327,9 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
         }
     }
 
-    copy_lanes<N>(mb.Px, s.Px); copy_lanes<N>(mb.Py, s.Py); copy_lanes<N>(mb.Pz, s.Pz);
+    copy_lanes<N, Isa>(mb.Px, s.Px); copy_lanes<N, Isa>(mb.Py, s.Py); copy_lanes<N, Isa>(mb.Pz, s.Pz);
 
-    copy_lanes<N>(mb.alpha, alpha);
+    copy_lanes<N, Isa>(mb.alpha, alpha);
 
     // Alpha MASK: discard below the cutoff (NaN alpha too).
     std::uint32_t kill = 0;

@@ -212,7 +212,7 @@ template <class Texels>
 }
 
 // The live lanes of an 8-bit texture one at a time; the others get 0.
-template <int N>
+template <int N, class Isa = IsaDefault>
 inline void fetch_fix_one_by_one(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
     if (at.live != (1u << N) - 1u)
         for (int l = 0; l < N; ++l) out.r[l] = out.g[l] = out.b[l] = out.a[l] = 0.0f;
@@ -227,8 +227,8 @@ inline void fetch_fix_one_by_one(const Texture& tex, const TrilinearLanes& at, T
 }
 
 // The live lanes one at a time, for K float textures: src[k] is a texel array.
-template <int N, int K, class Texels>
-inline void fetch_lanes_one_by_one(const Texels* const* src, const TrilinearLanes& at, TexelLanes* const* out) {
+template <int N, int K, class Texels, class Isa = IsaDefault>
+inline void fetch_texels_one_by_one(const Texels* const* src, const TrilinearLanes& at, TexelLanes* const* out) {
     if (at.live != (1u << N) - 1u) {
         for (int k = 0; k < K; ++k)
             for (int l = 0; l < N; ++l) out[k]->r[l] = out[k]->g[l] = out[k]->b[l] = out[k]->a[l] = 0.0f;
@@ -262,32 +262,32 @@ inline void fetch_lanes_one_by_one(const Texels* const* src, const TrilinearLane
     }
 }
 
-template <int N, int K>
+template <int N, int K, class Isa = IsaDefault>
 inline void fetch_lanes_one_by_one(const Texture* const* tex, const TrilinearLanes& at, TexelLanes* const* out) {
     bool float_only = true;
     for (int k = 0; k < K; ++k) float_only &= !tex[k]->is_unorm8();
     if (float_only) {
         const glm::vec4* texels[K];
         for (int k = 0; k < K; ++k) texels[k] = tex[k]->texel_data();
-        fetch_lanes_one_by_one<N, K, glm::vec4>(texels, at, out);
+        fetch_texels_one_by_one<N, K, glm::vec4, Isa>(texels, at, out);
         return;
     }
     for (int k = 0; k < K; ++k) {
         if (tex[k]->is_unorm8()) {
-            fetch_fix_one_by_one<N>(*tex[k], at, *out[k]);
+            fetch_fix_one_by_one<N, Isa>(*tex[k], at, *out[k]);
         } else {
             const glm::vec4* texels = tex[k]->texel_data();
-            fetch_lanes_one_by_one<N, 1, glm::vec4>(&texels, at, out + k);
+            fetch_texels_one_by_one<N, 1, glm::vec4, Isa>(&texels, at, out + k);
         }
     }
 }
 
-template <int N>
+template <int N, class Isa = IsaDefault>
 inline void fetch_lanes_one_by_one(const Texture* const* tex, int count, const TrilinearLanes& at,
                                    TexelLanes* const* out) {
-    for (; count >= 3; count -= 3, tex += 3, out += 3) fetch_lanes_one_by_one<N, 3>(tex, at, out);
-    if (count == 2) fetch_lanes_one_by_one<N, 2>(tex, at, out);
-    if (count == 1) fetch_lanes_one_by_one<N, 1>(tex, at, out);
+    for (; count >= 3; count -= 3, tex += 3, out += 3) fetch_lanes_one_by_one<N, 3, Isa>(tex, at, out);
+    if (count == 2) fetch_lanes_one_by_one<N, 2, Isa>(tex, at, out);
+    if (count == 1) fetch_lanes_one_by_one<N, 1, Isa>(tex, at, out);
 }
 
 #ifdef __AVX2__
@@ -432,7 +432,7 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
 constexpr int kSparseLanes = 4;
 
 
-template <int N>
+template <int N, class Isa = IsaDefault>
 inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
 #ifdef PRAST_SIMD16
     constexpr int W = N >= 16 ? 16 : (N >= 8 ? 8 : 4);
@@ -440,11 +440,11 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
     constexpr int W = N >= 8 ? 8 : 4;
 #endif
     if (__builtin_popcount(at.live) <= kSparseLanes) {
-        fetch_fix_one_by_one<N>(tex, at, out);  // any channel count
+        fetch_fix_one_by_one<N, Isa>(tex, at, out);  // any channel count
         return;
     }
 #if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
-    if constexpr (N == 16) {
+    if constexpr (N == 16 && std::is_same_v<Isa, IsaDefault>) {
         if (use_avx512()) {
             fetch_unorm8_lanes16_avx512(tex, at, out, components);
             return;
@@ -585,7 +585,7 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
 // and weights are read once and the texel loads of the textures overlap.
 // components[k] (bit 0 r, 1 g, 2 b, 3 a; null: all) says which components of
 // out[k] the caller reads: the gathers skip the others (left unwritten).
-template <int N = kBlockLanes>
+template <int N = kBlockLanes, class Isa = sample_lanes_detail::IsaDefault>
 inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const TrilinearLanes& at,
                                   TexelLanes* const* out, const std::uint8_t* components = nullptr) {
     using namespace sample_lanes_detail;
@@ -595,20 +595,20 @@ inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const Tr
     int n_rest = 0;
     for (int k = 0; k < count; ++k) {
         if (tex[k]->is_unorm8()) {
-            fetch_unorm8_lanes<N>(*tex[k], at, *out[k], components ? components[k] : 0xFu);
+            fetch_unorm8_lanes<N, Isa>(*tex[k], at, *out[k], components ? components[k] : 0xFu);
             continue;
         }
         rest[n_rest] = tex[k];
         rest_out[n_rest++] = out[k];
         if (n_rest == 3) {
-            fetch_lanes_one_by_one<N, 3>(rest, at, rest_out);
+            fetch_lanes_one_by_one<N, 3, Isa>(rest, at, rest_out);
             n_rest = 0;
         }
     }
-    fetch_lanes_one_by_one<N>(rest, n_rest, at, rest_out);
+    fetch_lanes_one_by_one<N, Isa>(rest, n_rest, at, rest_out);
 #else
     (void)components;
-    fetch_lanes_one_by_one<N>(tex, count, at, out);
+    fetch_lanes_one_by_one<N, Isa>(tex, count, at, out);
 #endif
 }
 

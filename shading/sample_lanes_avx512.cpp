@@ -10,6 +10,7 @@
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
+#include "shading/material_lanes.h"
 #include "shading/sample_lanes.h"
 
 #include <cstdlib>
@@ -36,3 +37,12 @@ void prepare_trilinear_lanes16_avx512(const Texture& tex, const float* u, const 
 }
 
 } // namespace prast::sample_lanes_detail
+
+namespace prast {
+
+std::uint32_t sample_material_lanes16_avx512(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
+                                             MaterialBlock& mb) {
+    return sample_material_lanes<16, sample_lanes_detail::IsaAvx512>(bm, s, live, mb);
+}
+
+} // namespace prast
