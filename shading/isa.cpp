@@ -1,13 +1,13 @@
 // Run-time choice of the AVX-512 block fetch (sample_lanes.h), compiled for
 // the build's own ISA so that it runs on any CPU.
-#include "shading/sample_lanes.h"
+#include "shading/isa.h"
 
 #include <cstdlib>
 #include <cstring>
 
-namespace prast::sample_lanes_detail {
+namespace prast {
 
-#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+#if PRAST_CALLS_AVX512
 bool use_avx512() {
     static const bool use = [] {
         const char* env = std::getenv("PRAST_AVX512");
@@ -21,4 +21,4 @@ bool use_avx512() {
 }
 #endif
 
-} // namespace prast::sample_lanes_detail
+} // namespace prast

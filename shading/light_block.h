@@ -14,9 +14,11 @@
 #pragma once
 
 #include <cmath>
+#include <type_traits>
 
 #include "raster/limits.h"
 #include "shading/brdf.h"
+#include "shading/isa.h"
 #include "shading/shadow/shadow_lanes.h"
 #include "shading/surface.h"
 
@@ -67,7 +69,7 @@ namespace light_block_detail {
 
 // DfgTable::lookup() for the first N lanes at (NoV, rough): taps in a
 // vectorised loop, then one 4-channel bilinear per lane.
-template <int N>
+template <int N, class Isa = IsaDefault>
 inline void dfg_lanes(const DfgTable& table, const float* __restrict NoV, const float* __restrict rough,
                       float* __restrict A, float* __restrict B, float* __restrict Kd) {
     alignas(64) std::int32_t idx[4][N];
@@ -88,14 +90,14 @@ inline void dfg_lanes(const DfgTable& table, const float* __restrict NoV, const 
 } // namespace light_block_detail
 
 // apply_energy_terms() for the first N lanes, from a DFG table.
-template <int N = kBlockLanes>
+template <int N = kBlockLanes, class Isa = IsaDefault>
 inline void energy_lanes(const MaterialBlock& __restrict m, const ViewLanes& __restrict w, const DfgTable& table,
                          EnergyLanes& __restrict e) {
     using light_block_detail::clamp01;
     alignas(64) float NoV[N], A[N], B[N], Kd[N];
     for (int l = 0; l < N; ++l)
         NoV[l] = light_block_detail::clamp_nov(w.Nx[l] * w.vx[l] + w.Ny[l] * w.vy[l] + w.Nz[l] * w.vz[l]);
-    light_block_detail::dfg_lanes<N>(table, NoV, w.rough, A, B, Kd);
+    light_block_detail::dfg_lanes<N, Isa>(table, NoV, w.rough, A, B, Kd);
     for (int l = 0; l < N; ++l) {
         const float km = 1.0f - m.metallic[l];
         e.comp_r[l] = energy_compensation(w.F0r[l], A[l], B[l]);
@@ -110,7 +112,7 @@ inline void energy_lanes(const MaterialBlock& __restrict m, const ViewLanes& __r
 // One light's contribution f * radiance * n.l, added to out, for the first N
 // lanes (the fragment program packs the live lanes of a sparse block first).
 // Shaped: a point light with a spot cone or a range (light_falloff()).
-template <bool Point, bool Gltf, bool Energy, bool Shaped, int N = kBlockLanes>
+template <bool Point, bool Gltf, bool Energy, bool Shaped, int N = kBlockLanes, class Isa = IsaDefault>
 inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L, const ViewLanes& __restrict w,
                         const EnergyLanes& __restrict e, RadianceBlock& __restrict out) {
     const float* __restrict vx = w.vx;
@@ -132,7 +134,7 @@ inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L
     (void)range_on; (void)spot_on; (void)range_inv2; (void)cone_scale; (void)cone_offset;
     // Shadow: light_visibility() per lane, 1 without a map.
     alignas(64) float vis[N];
-    if (L.shadow) shadow_visibility_lanes<N>(*L.shadow, m.Px, m.Py, m.Pz, m.Gx, m.Gy, m.Gz, L.direction, vis);
+    if (L.shadow) shadow_visibility_lanes<N, Isa>(*L.shadow, m.Px, m.Py, m.Pz, m.Gx, m.Gy, m.Gz, L.direction, vis);
     else for (int l = 0; l < N; ++l) vis[l] = 1.0f;
     for (int l = 0; l < N; ++l) {
         // Light direction and radiance at P (light_at).
@@ -219,7 +221,7 @@ inline void light_lanes(const MaterialBlock& __restrict m, const ShadingLight& L
 // ibl_terms() for the first N lanes, added to out: the taps of the prefiltered
 // map, the DFG table and the SH in vectorised loops, then the texel reads lane
 // by lane, then the sums.
-template <int N = kBlockLanes>
+template <int N = kBlockLanes, class Isa = IsaDefault>
 inline void ibl_lanes(const MaterialBlock& __restrict m, const ViewLanes& __restrict w, const ShadingContext& ctx,
                       RadianceBlock& __restrict out) {
     using light_block_detail::clamp01;
@@ -291,7 +293,7 @@ inline void ibl_lanes(const MaterialBlock& __restrict m, const ViewLanes& __rest
         const Texel4 c = a + (b - a) * t[l];
         Pr[l] = c[0]; Pg[l] = c[1]; Pb[l] = c[2];
     }
-    light_block_detail::dfg_lanes<N>(*ctx.dfg_ibl, NoV, w.rough, A, B, Kd);
+    light_block_detail::dfg_lanes<N, Isa>(*ctx.dfg_ibl, NoV, w.rough, A, B, Kd);
     // The lobes' weights: specular albedo and kd (the branch outside the loops).
     alignas(64) float sr[N], sg[N], sb[N], kr[N], kg[N], kb[N];
     if (ctx.energy) {
@@ -328,11 +330,25 @@ inline void ibl_lanes(const MaterialBlock& __restrict m, const ViewLanes& __rest
     }
 }
 
+#if PRAST_CALLS_AVX512
+// shade_block_lanes<16, IsaAvx512>, compiled for AVX-512 alone
+// (shading/sample_lanes_avx512.cpp) and called only when the CPU has it.
+void shade_block_lanes16_avx512(const MaterialBlock& m, const ShadingContext& ctx, RadianceBlock& out);
+#endif
+
 // shade_surface() for the first N lanes of m.
-template <int N = kBlockLanes>
+template <int N = kBlockLanes, class Isa = IsaDefault>
 inline void shade_block_lanes(const MaterialBlock& __restrict m, const ShadingContext& ctx,
                               RadianceBlock& __restrict out) {
     static_assert(N % 4 == 0 && N <= kBlockLanes, "whole vectors of lanes");
+#if PRAST_CALLS_AVX512
+    if constexpr (N == 16 && std::is_same_v<Isa, IsaDefault>) {
+        if (use_avx512()) {
+            shade_block_lanes16_avx512(m, ctx, out);
+            return;
+        }
+    }
+#endif
     if (m.unlit) {  // KHR_materials_unlit (shade_surface()): the base colour term alone
         for (int l = 0; l < N; ++l) {
             out.r[l] = m.ar[l];
@@ -384,32 +400,32 @@ inline void shade_block_lanes(const MaterialBlock& __restrict m, const ShadingCo
 
     EnergyLanes e;
     const bool energy = ctx.energy && ctx.dfg_light && !ctx.lights.empty();
-    if (energy) energy_lanes<N>(m, w, *ctx.dfg_light, e);
+    if (energy) energy_lanes<N, Isa>(m, w, *ctx.dfg_light, e);
     for (const ShadingLight& L : ctx.lights) {
         if (energy) {
             if (L.shaped()) {
-                if (gltf) light_lanes<true, true, true, true, N>(m, L, w, e, out);
-                else light_lanes<true, false, true, true, N>(m, L, w, e, out);
+                if (gltf) light_lanes<true, true, true, true, N, Isa>(m, L, w, e, out);
+                else light_lanes<true, false, true, true, N, Isa>(m, L, w, e, out);
             } else if (L.point) {
-                if (gltf) light_lanes<true, true, true, false, N>(m, L, w, e, out);
-                else light_lanes<true, false, true, false, N>(m, L, w, e, out);
+                if (gltf) light_lanes<true, true, true, false, N, Isa>(m, L, w, e, out);
+                else light_lanes<true, false, true, false, N, Isa>(m, L, w, e, out);
             } else {
-                if (gltf) light_lanes<false, true, true, false, N>(m, L, w, e, out);
-                else light_lanes<false, false, true, false, N>(m, L, w, e, out);
+                if (gltf) light_lanes<false, true, true, false, N, Isa>(m, L, w, e, out);
+                else light_lanes<false, false, true, false, N, Isa>(m, L, w, e, out);
             }
         } else if (L.shaped()) {
-            if (gltf) light_lanes<true, true, false, true, N>(m, L, w, e, out);
-            else light_lanes<true, false, false, true, N>(m, L, w, e, out);
+            if (gltf) light_lanes<true, true, false, true, N, Isa>(m, L, w, e, out);
+            else light_lanes<true, false, false, true, N, Isa>(m, L, w, e, out);
         } else if (L.point) {
-            if (gltf) light_lanes<true, true, false, false, N>(m, L, w, e, out);
-            else light_lanes<true, false, false, false, N>(m, L, w, e, out);
+            if (gltf) light_lanes<true, true, false, false, N, Isa>(m, L, w, e, out);
+            else light_lanes<true, false, false, false, N, Isa>(m, L, w, e, out);
         } else {
-            if (gltf) light_lanes<false, true, false, false, N>(m, L, w, e, out);
-            else light_lanes<false, false, false, false, N>(m, L, w, e, out);
+            if (gltf) light_lanes<false, true, false, false, N, Isa>(m, L, w, e, out);
+            else light_lanes<false, false, false, false, N, Isa>(m, L, w, e, out);
         }
     }
     if (ctx.env) {
-        ibl_lanes<N>(m, w, ctx, out);
+        ibl_lanes<N, Isa>(m, w, ctx, out);
         return;
     }
     for (int l = 0; l < N; ++l) {

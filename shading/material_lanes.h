@@ -49,7 +49,7 @@ struct SurfaceLanes {
 namespace material_lanes_detail {
 
 // safe_normalize(v, fallback) of surface.h, per lane.
-template <int N, class Isa = sample_lanes_detail::IsaDefault>
+template <int N, class Isa = IsaDefault>
 [[gnu::always_inline]] inline void safe_normalize_lanes(float* __restrict x, float* __restrict y,
                                                         float* __restrict z, const float* __restrict fx,
                                                         const float* __restrict fy, const float* __restrict fz) {
@@ -63,28 +63,28 @@ template <int N, class Isa = sample_lanes_detail::IsaDefault>
     }
 }
 
-template <int N, class Isa = sample_lanes_detail::IsaDefault>
+template <int N, class Isa = IsaDefault>
 inline void copy_lanes(float* dst, const float* src) { std::memcpy(dst, src, sizeof(float) * N); }
 
 } // namespace material_lanes_detail
 
 // Fills the first N lanes of mb for the lanes in `live` (the others get
 // values nobody reads) and returns the live lanes an alpha MASK discards.
-#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+#if PRAST_CALLS_AVX512
 // sample_material_lanes<16, IsaAvx512>, compiled for AVX-512 alone
 // (shading/sample_lanes_avx512.cpp) and called only when the CPU has it.
 std::uint32_t sample_material_lanes16_avx512(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
                                              MaterialBlock& mb);
 #endif
 
-template <int N = kBlockLanes, class Isa = sample_lanes_detail::IsaDefault>
+template <int N = kBlockLanes, class Isa = IsaDefault>
 inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
                                            MaterialBlock& mb) {
     using namespace material_lanes_detail;
     static_assert(N % 4 == 0 && N <= kBlockLanes, "whole vectors of lanes");
-#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
-    if constexpr (N == 16 && std::is_same_v<Isa, sample_lanes_detail::IsaDefault>) {
-        if (sample_lanes_detail::use_avx512()) return sample_material_lanes16_avx512(bm, s, live, mb);
+#if PRAST_CALLS_AVX512
+    if constexpr (N == 16 && std::is_same_v<Isa, IsaDefault>) {
+        if (use_avx512()) return sample_material_lanes16_avx512(bm, s, live, mb);
     }
 #endif
     const Material& m = *bm.m;

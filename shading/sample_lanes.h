@@ -33,6 +33,7 @@
 #endif
 
 #include "raster/limits.h"
+#include "shading/isa.h"
 #include "shading/simd.h"
 #include "shading/texture.h"
 
@@ -76,13 +77,7 @@ namespace sample_lanes_detail {
 
 constexpr int kMaxN = kBlockLanes;
 
-// Tags for the instruction set the lane loops are instantiated for: a copy
-// compiled for AVX-512 must not share a name with the default one (the
-// linker would keep either).
-struct IsaDefault {};
-struct IsaAvx512 {};
-
-#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+#if PRAST_CALLS_AVX512
 // Sixteen lanes compiled for AVX-512 alone (shading/sample_lanes_avx512.cpp)
 // and called only when the CPU has it: the same integers and floats per
 // lane as the default code. fetch_unorm8_lanes<16, 16, C> for the texture's
@@ -90,9 +85,6 @@ struct IsaAvx512 {};
 void fetch_unorm8_lanes16_avx512(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components);
 void prepare_trilinear_lanes16_avx512(const Texture& tex, const float* u, const float* v, const float* lambda,
                                       const std::uint8_t* quad, std::uint32_t live, TrilinearLanes& out);
-// The CPU runs AVX-512 (F, BW, DQ, VL) and PRAST_AVX512 is not 0 in the
-// environment; read once.
-bool use_avx512();
 #endif
 
 // One mip level per lane (its quad's).
@@ -443,7 +435,7 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
         fetch_fix_one_by_one<N, Isa>(tex, at, out);  // any channel count
         return;
     }
-#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+#if PRAST_CALLS_AVX512
     if constexpr (N == 16 && std::is_same_v<Isa, IsaDefault>) {
         if (use_avx512()) {
             fetch_unorm8_lanes16_avx512(tex, at, out, components);
@@ -470,12 +462,12 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
 // blocks first) and quad[l] < kMaxQuadSlots names lane l's quad. Only the
 // lanes in `live` are fetched later, but every lane gets valid indices
 // (reduce() folds any coordinate).
-template <int N = kBlockLanes, class Isa = sample_lanes_detail::IsaDefault>
+template <int N = kBlockLanes, class Isa = IsaDefault>
 inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const float* v, const float* lambda,
                                     const std::uint8_t* quad, std::uint32_t live, TrilinearLanes& out) {
     using namespace sample_lanes_detail;
     static_assert(N % 4 == 0 && N <= kMaxN, "whole vectors of lanes");
-#if defined(PRAST_AVX512_DISPATCH) && !defined(PRAST_SIMD16)
+#if PRAST_CALLS_AVX512
     if constexpr (N == 16 && std::is_same_v<Isa, IsaDefault>) {
         if (use_avx512()) {
             prepare_trilinear_lanes16_avx512(tex, u, v, lambda, quad, live, out);
@@ -585,7 +577,7 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
 // and weights are read once and the texel loads of the textures overlap.
 // components[k] (bit 0 r, 1 g, 2 b, 3 a; null: all) says which components of
 // out[k] the caller reads: the gathers skip the others (left unwritten).
-template <int N = kBlockLanes, class Isa = sample_lanes_detail::IsaDefault>
+template <int N = kBlockLanes, class Isa = IsaDefault>
 inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const TrilinearLanes& at,
                                   TexelLanes* const* out, const std::uint8_t* components = nullptr) {
     using namespace sample_lanes_detail;

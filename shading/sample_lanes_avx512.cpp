@@ -1,15 +1,18 @@
-// The 8-bit block fetch sixteen lanes at a time, and the preparation of the
-// lanes' texel indices, for AVX2 builds on CPUs with AVX-512 (sample_lanes.h
-// chooses at run time). This file alone is compiled with -mavx512f/bw/dq/vl:
-// everything it instantiates is a template on Simd<16> or tagged IsaAvx512,
-// which no other file instantiates, so no inline function compiled here can
-// stand in for another file's copy on a CPU without AVX-512 (the `isa` test
-// lists this object's symbols to keep it so).
+// The 16-lane loops of a 4x4 block (the texture fetch and its texel indices,
+// the material lanes, the lighting) for x86-64-v3 builds on CPUs with
+// AVX-512, which sample_lanes.h, material_lanes.h and light_block.h call
+// where use_avx512() says so. This file alone is compiled with
+// -mavx512f/bw/dq/vl: everything it instantiates is a template on Simd<16>
+// or tagged IsaAvx512 (shading/isa.h), which no other file instantiates, so
+// no inline function compiled here can stand in for another file's copy on
+// a CPU without AVX-512 (the `isa` test lists this object's symbols).
+
 // GCC 12's AVX-512 intrinsics pass an undefined register to their builtins,
 // which -Wmaybe-uninitialized reports wherever they are inlined (GCC bug 105593).
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
+#include "shading/light_block.h"
 #include "shading/material_lanes.h"
 #include "shading/sample_lanes.h"
 
@@ -42,7 +45,11 @@ namespace prast {
 
 std::uint32_t sample_material_lanes16_avx512(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
                                              MaterialBlock& mb) {
-    return sample_material_lanes<16, sample_lanes_detail::IsaAvx512>(bm, s, live, mb);
+    return sample_material_lanes<16, IsaAvx512>(bm, s, live, mb);
+}
+
+void shade_block_lanes16_avx512(const MaterialBlock& m, const ShadingContext& ctx, RadianceBlock& out) {
+    shade_block_lanes<16, IsaAvx512>(m, ctx, out);
 }
 
 } // namespace prast

@@ -10,6 +10,8 @@
 
 #include <immintrin.h>
 
+#include "shading/isa.h"
+
 namespace prast {
 
 // W lanes per instruction: 8 (ymm) or 4 (xmm).
@@ -127,8 +129,7 @@ private:
     }
 };
 
-#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512DQ__)
-#define PRAST_SIMD16 1
+#ifdef PRAST_SIMD16
 // 16 lanes (zmm) for x86-64-v4 builds: a whole 4x4 block per instruction.
 // Comparisons give vector masks (all ones or zeros per lane) as the narrower
 // widths do, turned into AVX-512 mask registers where an instruction takes one.

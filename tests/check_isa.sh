@@ -14,6 +14,7 @@ nm -C --defined-only "$obj" | awk '$2 ~ /^[TtWwVvi]$/' > "${TMPDIR:-/tmp}/isa-sy
 trap 'rm -f "${TMPDIR:-/tmp}/isa-symbols.$$"' EXIT
 grep -q 'fetch_unorm8_lanes16_avx512' "${TMPDIR:-/tmp}/isa-symbols.$$" || { echo "isa: $obj lacks its entry point"; exit 1; }
 bad=$(grep -v -e 'fetch_unorm8_lanes16_avx512' -e 'prepare_trilinear_lanes16_avx512' -e 'sample_material_lanes16_avx512' \
+  -e 'shade_block_lanes16_avx512' \
   -e 'fetch_unorm8_lanes<16, 16, [1-4]>' -e 'Simd<16>' -e 'IsaAvx512' \
   "${TMPDIR:-/tmp}/isa-symbols.$$" || true)
 if [ -n "$bad" ]; then

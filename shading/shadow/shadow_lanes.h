@@ -15,6 +15,7 @@
 
 #include "raster/limits.h"
 #include "shading/shadow/shadow_map.h"
+#include "shading/isa.h"
 #include "shading/simd.h"
 
 namespace prast {
@@ -23,7 +24,7 @@ namespace prast {
 // W = V's width lanes of shadow_pcf(), a gather per tap: first the least and
 // greatest distance of each lane's footprint cell, which settle lanes all lit
 // (1) or all in shadow (0); the 16 taps only when a lane is in a penumbra.
-template <class V>
+template <class V, class Isa = IsaDefault>
 inline void shadow_pcf_group(const ShadowMap& map, const std::int32_t* base, const std::int32_t* cell,
                              const float* fx, const float* fy, const float* thr, float* vis) {
     using F = typename V::F;
@@ -58,7 +59,7 @@ inline void shadow_pcf_group(const ShadowMap& map, const std::int32_t* base, con
 // vis[l] = the visibility of receiver l (positions P, geometric normals G,
 // unit, facing the viewer) from the light of `map`; l_dir is the direction
 // towards a directional light (point lights compute their own).
-template <int N = kBlockLanes>
+template <int N = kBlockLanes, class Isa = IsaDefault>
 inline void shadow_visibility_lanes(const ShadowMap& map, const float* __restrict Px, const float* __restrict Py,
                                     const float* __restrict Pz, const float* __restrict Gx,
                                     const float* __restrict Gy, const float* __restrict Gz, const glm::vec3& l_dir,
@@ -81,9 +82,9 @@ inline void shadow_visibility_lanes(const ShadowMap& map, const float* __restric
     else taps(std::false_type{});
 #ifdef __AVX2__
     if constexpr (N >= 8) {
-        for (int h = 0; h < N; h += 8) shadow_pcf_group<Simd<8>>(map, base + h, cell + h, fx + h, fy + h, thr + h, vis + h);
+        for (int h = 0; h < N; h += 8) shadow_pcf_group<Simd<8>, Isa>(map, base + h, cell + h, fx + h, fy + h, thr + h, vis + h);
     } else {
-        shadow_pcf_group<Simd<4>>(map, base, cell, fx, fy, thr, vis);
+        shadow_pcf_group<Simd<4>, Isa>(map, base, cell, fx, fy, thr, vis);
     }
 #else
     for (int l = 0; l < N; ++l) {
