@@ -2,7 +2,8 @@
 // steps: prepare_trilinear_lanes() turns the lanes' uv and their quads' lambda
 // into texel indices and filter weights (branch-free loops over lanes, which
 // the compiler vectorises), and fetch_trilinear_lanes() reads and blends the
-// texels. 8-bit textures are read 8 (or 4) lanes per instruction: an AVX2
+// texels. 8-bit textures are read 8 (or 4; 16 where the 16-lane loops run
+// their AVX-512 copy, shading/isa.h) lanes per instruction: an AVX2
 // gather of each tap's packed texel bytes, the channels unpacked into their
 // 15-bit codes (a shift, or a gather from the sRGB code table), then the
 // fixed-point lerps of texture.h, each one multiply-add of 16-bit pairs
@@ -191,6 +192,7 @@ template <class Texels>
 
 // Lane l of an 8-bit texture: Texture::trilinear_wrapped() / filtered_wrapped()'s
 // fixed-point steps on the prepared indices and weights.
+template <class Isa = IsaDefault>
 [[gnu::always_inline]] inline glm::vec4 fix_lane(const Texture& tex, const TrilinearLanes& at, int l) {
     const bool nearest = (at.nearest >> l) & 1u;
     auto level = [&](const std::int32_t (*idx)[kMaxN], const float* tx, const float* ty) {
@@ -210,7 +212,7 @@ inline void fetch_fix_one_by_one(const Texture& tex, const TrilinearLanes& at, T
         for (int l = 0; l < N; ++l) out.r[l] = out.g[l] = out.b[l] = out.a[l] = 0.0f;
     for (std::uint32_t m = at.live; m; m &= m - 1) {
         const int l = __builtin_ctz(m);
-        const glm::vec4 c = fix_lane(tex, at, l);
+        const glm::vec4 c = fix_lane<Isa>(tex, at, l);
         out.r[l] = c.r;
         out.g[l] = c.g;
         out.b[l] = c.b;

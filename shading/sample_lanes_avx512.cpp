@@ -5,7 +5,10 @@
 // -mavx512f/bw/dq/vl: everything it instantiates is a template on Simd<16>
 // or tagged IsaAvx512 (shading/isa.h), which no other file instantiates, so
 // no inline function compiled here can stand in for another file's copy on
-// a CPU without AVX-512 (the `isa` test lists this object's symbols).
+// a CPU without AVX-512 (the `isa` test lists this object's symbols). The
+// file is always optimised (shading/CMakeLists.txt), so that the small inline
+// helpers it calls are inlined rather than emitted as shared copies; the
+// larger ones (fix_lane, with its lambda) carry the tag too.
 
 // GCC 12's AVX-512 intrinsics pass an undefined register to their builtins,
 // which -Wmaybe-uninitialized reports wherever they are inlined (GCC bug 105593).

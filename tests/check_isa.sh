@@ -10,7 +10,9 @@ for o in "$@"; do
   case "$o" in *sample_lanes_avx512.cpp.o) obj="$o" ;; esac
 done
 [ -n "$obj" ] || { echo "isa: no sample_lanes_avx512 object among the arguments"; exit 1; }
-nm -C --defined-only "$obj" | awk '$2 ~ /^[TtWwVvi]$/' > "${TMPDIR:-/tmp}/isa-symbols.$$"
+# Code other objects can bind to: global (T), weak (W) and indirect (i)
+# functions. Local symbols (t) and data are no hazard.
+nm -C --defined-only "$obj" | awk '$2 ~ /^[TWi]$/' > "${TMPDIR:-/tmp}/isa-symbols.$$"
 trap 'rm -f "${TMPDIR:-/tmp}/isa-symbols.$$"' EXIT
 grep -q 'fetch_unorm8_lanes16_avx512' "${TMPDIR:-/tmp}/isa-symbols.$$" || { echo "isa: $obj lacks its entry point"; exit 1; }
 bad=$(grep -v -e 'fetch_unorm8_lanes16_avx512' -e 'prepare_trilinear_lanes16_avx512' -e 'sample_material_lanes16_avx512' \
