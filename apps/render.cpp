@@ -42,6 +42,7 @@
 #include "scene/load_scene.h"
 #include "scene/messages.h"
 #include "scene/write_image.h"
+#include "shading/isa.h"
 #include "shading/ibl/environment.h"
 #include "shading/output8.h"
 #include "shading/surface.h"
@@ -590,9 +591,9 @@ int run(int argc, char** argv) {
     if (opt.stats) {
         std::printf("scene                  %zu triangles, %zu meshes, %zu materials, %zu images\n"
                     "time load              %.3f ms\ntime textures          %.3f ms\nthreads                %d, "
-                    "tile %d\n",
+                    "tile %d\nlanes                  %s\n",
                     scene.triangle_count(), scene.meshes.size(), scene.materials.size(), scene.images.size(),
-                    frame.load_ms, frame.textures_ms, renderer.threads(), renderer.tile_size());
+                    frame.load_ms, frame.textures_ms, renderer.threads(), renderer.tile_size(), lane_isa());
         if (environment) {
             const EnvironmentTimings& et = environment->timings();
             std::printf("environment            %dx%d\ntime environment       %.3f ms (mips %.3f, sh %.3f, "

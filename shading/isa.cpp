@@ -1,5 +1,5 @@
-// Run-time choice of the AVX-512 block fetch (sample_lanes.h), compiled for
-// the build's own ISA so that it runs on any CPU.
+// Run-time choice of the AVX-512 copy of the block loops (shading/isa.h),
+// compiled for the build's own ISA so that it runs on any CPU.
 #include "shading/isa.h"
 
 #include <cstdlib>
@@ -20,5 +20,19 @@ bool use_avx512() {
     return use;
 }
 #endif
+
+const char* lane_isa() {
+#if defined(PRAST_SIMD16)
+    return "avx512";
+#elif PRAST_CALLS_AVX512
+    return use_avx512() ? "avx512" : "avx2";
+#elif defined(__AVX2__)
+    return "avx2";
+#elif defined(__ARM_NEON)
+    return "neon";
+#else
+    return "portable";
+#endif
+}
 
 } // namespace prast

@@ -30,4 +30,8 @@ struct IsaAvx512 {};
 bool use_avx512();
 #endif
 
+// The lane code the 4x4 blocks run in this process: "avx512", "avx2",
+// "neon" or "portable" (render --stats prints it).
+const char* lane_isa();
+
 } // namespace prast

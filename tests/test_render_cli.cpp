@@ -26,6 +26,7 @@
 
 #include "apps/render_options.h"
 #include "scene/write_image.h"
+#include "shading/isa.h"
 #include "tests/cli_util.h"
 
 using namespace prast;
@@ -390,6 +391,16 @@ TEST_CASE("--repeat prints frame_ms min/median/max and --stats the counters") {
                             "time vertex", "time setup+bin", "time raster+shade", "time frame", "time load"})
         CHECK(s.out.find(key) != std::string::npos);
     CHECK(s.out.find("frame_ms") == std::string::npos);
+    // The lane code that ran: the build's, or AVX-512's copy where the CPU
+    // has it, which PRAST_AVX512=0 turns off.
+    const std::string lanes = std::string("lanes                  ") + lane_isa() + "\n";
+    CHECK(s.out.find(lanes) != std::string::npos);
+#ifndef PRAST_SIMD16
+    if (std::string(lane_isa()) == "avx512") {
+        CliRun off = box.run_exe(PRAST_RENDER_EXE, with(kSmall, {"--stats"}), "export PRAST_AVX512=0");
+        CHECK(off.out.find("lanes                  avx2\n") != std::string::npos);
+    }
+#endif
     // The repeated and the single render wrote the same image.
     CHECK(s.err.empty());
 }
