@@ -1,8 +1,9 @@
 #!/bin/sh
-# The `isa` test: the object compiled for AVX-512 (shading/sample_lanes_avx512.cpp)
-# defines only its entry points and templates on 16 lanes or tagged IsaAvx512, which no other
-# object instantiates, so the linker can never pick an AVX-512 copy of an
-# inline function that code for any CPU calls.
+# The `isa` test: the object compiled for AVX-512
+# (shading/sample_lanes_avx512.cpp) defines only its entry points and
+# templates on 16 lanes or tagged IsaAvx512, which no other object
+# instantiates, so the linker can never pick an AVX-512 copy of an inline
+# function that code for any CPU calls.
 #   sh tests/check_isa.sh OBJECT...   (the prast_shading objects; others are skipped)
 set -e
 obj=""
