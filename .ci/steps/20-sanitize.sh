@@ -21,9 +21,11 @@ export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:check_initialization_
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:suppressions=$PWD/tests/ubsan.supp"
 # Every test but `examples` (an install and a consumer build: no code of ours
 # runs there that the suite does not run), `docs` (the pages against what the
-# programs print: the same sessions and renders the other suites run) and
+# programs print: the same sessions and renders the other suites run),
 # `browser` (the page's behaviour in Chromium; every endpoint it calls, and
-# every attack on them, is the `serve` test, which runs here).
-ctest --test-dir build-asan -j2 --output-on-failure -E '^(examples|docs|browser)$'
+# every attack on them, is the `serve` test, which runs here) and
+# `manifest_avx2` (the renders of `manifest` again with the eight-lane code,
+# which `sample_lanes_avx2` already runs here against the scalar code).
+ctest --test-dir build-asan -j2 --output-on-failure -E '^(examples|docs|browser|manifest_avx2)$'
 
 echo "sanitize step: build $((built - start)) s, tests $(($(date +%s) - built)) s"
