@@ -179,20 +179,24 @@ inline __m128i select16(__m128i mask, __m128i t, __m128i f) {
 // in one add of bytes, whose carries stay inside each byte.
 inline __m128i add_mod256(__m128i x, __m128i p) { return _mm_add_epi8(x, p); }
 
-// Paeth (paeth_predict): a unless pa > min(pb, pc); then c if pb > pc, else b.
-// pa = |b - c| does not depend on a; from a the chain is a - c, the absolute
-// values, min, compare, select and the add: seven steps.
+// x + Paeth's prediction (paeth_predict): a unless pa > min(pb, pc); then c
+// if pb > pc, else b. pa = |b - c| does not depend on a; from a the chain is
+// a - c, the absolute values, min, compare, select and the add: seven steps.
+inline __m128i paeth_step(__m128i a, __m128i b, __m128i c, __m128i x) {
+    const __m128i bc = _mm_sub_epi16(b, c), pa = abs16(bc);
+    const __m128i ac = _mm_sub_epi16(a, c);
+    const __m128i pb = abs16(ac), pc = abs16(_mm_add_epi16(ac, bc));  // |a + b - 2c|
+    const __m128i not_a = _mm_cmpgt_epi16(pa, _mm_min_epi16(pb, pc));
+    const __m128i b_or_c = select16(_mm_cmpgt_epi16(pb, pc), c, b);
+    return add_mod256(x, select16(not_a, b_or_c, a));
+}
+
 template <int BPP>
 void paeth_sse2(const unsigned char* raw, const unsigned char* above, unsigned char* out, std::size_t n) {
     __m128i a = _mm_setzero_si128(), c = a;
     for (std::size_t i = 0; i < n; i += BPP) {
-        const __m128i b = load_pixel16(above + i), x = load_pixel16(raw + i);
-        const __m128i bc = _mm_sub_epi16(b, c), pa = abs16(bc);
-        const __m128i ac = _mm_sub_epi16(a, c);
-        const __m128i pb = abs16(ac), pc = abs16(_mm_add_epi16(ac, bc));  // |a + b - 2c|
-        const __m128i not_a = _mm_cmpgt_epi16(pa, _mm_min_epi16(pb, pc));
-        const __m128i b_or_c = select16(_mm_cmpgt_epi16(pb, pc), c, b);
-        a = add_mod256(x, select16(not_a, b_or_c, a));
+        const __m128i b = load_pixel16(above + i);
+        a = paeth_step(a, b, c, load_pixel16(raw + i));
         store_pixel16<BPP>(out + i, a);
         c = b;
     }
@@ -213,27 +217,11 @@ void paeth_two_rows_sse2(const unsigned char* raw0, const unsigned char* raw1, c
     __m128i v = zero, c = zero;
     for (std::size_t p = 0; p <= pixels; ++p) {
         const std::size_t i = p * BPP;
-        std::int32_t w0, w1 = 0, wb;
-        std::memcpy(&w0, raw0 + i, 4);
-        if (p > 0) std::memcpy(&w1, raw1 + i - BPP, 4);
-        std::memcpy(&wb, above + i, 4);
-        const __m128i x = _mm_unpacklo_epi8(_mm_unpacklo_epi32(_mm_cvtsi32_si128(w0), _mm_cvtsi32_si128(w1)), zero);
-        const __m128i b = _mm_unpacklo_epi64(_mm_unpacklo_epi8(_mm_cvtsi32_si128(wb), zero), v);
-        const __m128i bc = _mm_sub_epi16(b, c), pa = abs16(bc);
-        const __m128i ac = _mm_sub_epi16(v, c);
-        const __m128i pb = abs16(ac), pc = abs16(_mm_add_epi16(ac, bc));
-        const __m128i not_a = _mm_cmpgt_epi16(pa, _mm_min_epi16(pb, pc));
-        const __m128i b_or_c = select16(_mm_cmpgt_epi16(pb, pc), c, b);
-        __m128i next = add_mod256(x, select16(not_a, b_or_c, v));
-        const __m128i bytes = _mm_packus_epi16(next, next);
-        if (p < pixels) {
-            const std::int32_t word = _mm_cvtsi128_si32(bytes);
-            std::memcpy(out0 + i, &word, BPP);
-        }
-        if (p > 0) {
-            const std::int32_t word = _mm_cvtsi128_si32(_mm_srli_si128(bytes, 4));
-            std::memcpy(out1 + i - BPP, &word, BPP);
-        }
+        const __m128i x = _mm_unpacklo_epi64(load_pixel16(raw0 + i), p > 0 ? load_pixel16(raw1 + i - BPP) : zero);
+        const __m128i b = _mm_unpacklo_epi64(load_pixel16(above + i), v);
+        const __m128i next = paeth_step(v, b, c, x);
+        if (p < pixels) store_pixel16<BPP>(out0 + i, next);
+        if (p > 0) store_pixel16<BPP>(out1 + i - BPP, _mm_srli_si128(next, 8));
         v = next;
         c = b;
     }
