@@ -1,7 +1,7 @@
 // The instruction sets the lane code is compiled for. An x86-64-v3 build
-// carries a second copy of the 16-lane texture and material code compiled
-// for AVX-512 (shading/sample_lanes_avx512.cpp), called where the CPU has it;
-// an x86-64-v4 build has only that one, inline.
+// carries a second copy of the 16-lane texture, material and lighting loops
+// compiled for AVX-512 (shading/sample_lanes_avx512.cpp), called where the
+// CPU has it; an x86-64-v4 build has only that one, inline.
 #pragma once
 
 // This file is compiled with AVX-512 (F, BW, DQ): Simd<16> exists.

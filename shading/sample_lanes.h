@@ -81,8 +81,11 @@ constexpr int kMaxN = kBlockLanes;
 #if PRAST_CALLS_AVX512
 // Sixteen lanes compiled for AVX-512 alone (shading/sample_lanes_avx512.cpp)
 // and called only when the CPU has it: the same integers and floats per
-// lane as the default code. fetch_unorm8_lanes<16, 16, C> for the texture's
-// channel count, and prepare_trilinear_lanes<16, IsaAvx512>.
+// lane as the default code. fetch_unorm8_lanes<16, IsaAvx512> and
+// prepare_trilinear_lanes<16, IsaAvx512>. The material lanes switch to
+// their own AVX-512 copy as a whole (material_lanes.h), which calls these
+// directly; these serve other callers of the 16-lane sampler (the sampler
+// tests hold them to the scalar sampler over every wrap mode and filter).
 void fetch_unorm8_lanes16_avx512(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components);
 void prepare_trilinear_lanes16_avx512(const Texture& tex, const float* u, const float* v, const float* lambda,
                                       const std::uint8_t* quad, std::uint32_t live, TrilinearLanes& out);

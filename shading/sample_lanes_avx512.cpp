@@ -10,17 +10,9 @@
 // helpers it calls are inlined rather than emitted as shared copies; the
 // larger ones (fix_lane, with its lambda) carry the tag too.
 
-// GCC 12's AVX-512 intrinsics pass an undefined register to their builtins,
-// which -Wmaybe-uninitialized reports wherever they are inlined (GCC bug 105593).
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
 #include "shading/light_block.h"
 #include "shading/material_lanes.h"
 #include "shading/sample_lanes.h"
-
-#include <cstdlib>
-#include <cstring>
 
 #if !defined(PRAST_SIMD16)
 #error "sample_lanes_avx512.cpp needs AVX-512 F, BW and DQ (see shading/CMakeLists.txt)"
@@ -29,12 +21,7 @@
 namespace prast::sample_lanes_detail {
 
 void fetch_unorm8_lanes16_avx512(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
-    switch (tex.channels()) {
-    case 1: fetch_unorm8_lanes<16, 16, 1>(tex, at, out, components); return;
-    case 2: fetch_unorm8_lanes<16, 16, 2>(tex, at, out, components); return;
-    case 3: fetch_unorm8_lanes<16, 16, 3>(tex, at, out, components); return;
-    default: fetch_unorm8_lanes<16, 16, 4>(tex, at, out, components); return;
-    }
+    fetch_unorm8_lanes<16, IsaAvx512>(tex, at, out, components);
 }
 
 void prepare_trilinear_lanes16_avx512(const Texture& tex, const float* u, const float* v, const float* lambda,

@@ -1,5 +1,6 @@
 // W float or int32 lanes per instruction under AVX2: Simd<8> (ymm) and
-// Simd<4> (xmm), and Simd<16> (zmm) under AVX-512, with the same member names, so a lane loop is written once
+// Simd<4> (xmm), and Simd<16> (zmm) where the file is compiled for AVX-512,
+// with the same member names, so a lane loop is written once
 // and instantiated for whole blocks and for packed sparse ones
 // (sample_lanes.h texture fetches, shadow_lanes.h PCF).
 #pragma once
@@ -130,11 +131,14 @@ private:
 };
 
 #ifdef PRAST_SIMD16
-// 16 lanes (zmm) for x86-64-v4 builds: a whole 4x4 block per instruction.
+// 16 lanes (zmm): a whole 4x4 block per instruction, in x86-64-v4 builds and
+// in the AVX-512 copy of the block loops (shading/isa.h).
 // Comparisons give vector masks (all ones or zeros per lane) as the narrower
 // widths do, turned into AVX-512 mask registers where an instruction takes one.
-// The gathers are the masked forms with a zero source (GCC 12's unmasked ones
-// read an undefined register, which -Wmaybe-uninitialized reports).
+// GCC 12's plain forms of many AVX-512 intrinsics pass an undefined register
+// to their builtins, which -Wmaybe-uninitialized reports wherever they are
+// inlined (GCC bug 105593): the gathers are the masked forms with a zero
+// source, the rest the zero-masked forms with every lane set.
 template <> struct Simd<16> {
     using F = __m512;
     using I = __m512i;
@@ -155,25 +159,25 @@ template <> struct Simd<16> {
     }
     // As Simd<8>::gather_q: eight qwords per gather, in lane order.
     template <int Scale, int Shift> static void gather_q(const std::uint8_t* base, I idx, I& low, I& shifted) {
-        const I a = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_castsi512_si256(idx), base, Scale);
-        const I b = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_extracti64x4_epi64(idx, 1), base, Scale);
-        low = join(_mm512_cvtepi64_epi32(a), _mm512_cvtepi64_epi32(b));
-        shifted = join(_mm512_cvtepi64_epi32(_mm512_srli_epi64(a, Shift)), _mm512_cvtepi64_epi32(_mm512_srli_epi64(b, Shift)));
+        const I a = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_maskz_extracti64x4_epi64(0xF, idx, 0),
+                                                base, Scale);
+        const I b = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_maskz_extracti64x4_epi64(0xF, idx, 1),
+                                                base, Scale);
+        low = join(low_dwords(a), low_dwords(b));
+        shifted = join(low_dwords(_mm512_maskz_srli_epi64(0xFF, a, Shift)), low_dwords(_mm512_maskz_srli_epi64(0xFF, b, Shift)));
     }
     static I add_i(I a, I b) { return _mm512_add_epi32(a, b); }
     static I sub_i(I a, I b) { return _mm512_sub_epi32(a, b); }
     static I and_i(I a, I b) { return _mm512_and_si512(a, b); }
     static I or_i(I a, I b) { return _mm512_or_si512(a, b); }
-    // The zero-masked forms of the shifts: GCC 12's plain ones pass an undefined
-    // register to their builtin (the same false -Wmaybe-uninitialized).
     template <int N> static I slli_i(I a) { return _mm512_maskz_slli_epi32(0xFFFF, a, N); }
     template <int N> static I srli_i(I a) { return _mm512_maskz_srli_epi32(0xFFFF, a, N); }
     static I madd_i(I a, I b) { return _mm512_madd_epi16(a, b); }
-    static I cvtt(F a) { return _mm512_cvttps_epi32(a); }
+    static I cvtt(F a) { return _mm512_maskz_cvttps_epi32(0xFFFF, a); }
     static I select_i(I mask, I yes, I no) { return _mm512_mask_blend_epi32(_mm512_movepi32_mask(mask), no, yes); }
     static I srlv_i(I a, I n) { return _mm512_maskz_srlv_epi32(0xFFFF, a, n); }
     static I cmpeq_i(I a, I b) { return _mm512_movm_epi32(_mm512_cmpeq_epi32_mask(a, b)); }
-    static F cvt(I a) { return _mm512_cvtepi32_ps(a); }
+    static F cvt(I a) { return _mm512_maskz_cvtepi32_ps(0xFFFF, a); }
     static F add(F a, F b) { return _mm512_add_ps(a, b); }
     static F sub(F a, F b) { return _mm512_sub_ps(a, b); }
     static F mul(F a, F b) { return _mm512_mul_ps(a, b); }
@@ -190,7 +194,8 @@ template <> struct Simd<16> {
     static bool all_i(I mask) { return _mm512_movepi32_mask(mask) == 0xFFFF; }
 
 private:
-    static I join(__m256i lo, __m256i hi) { return _mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1); }
+    static __m256i low_dwords(I q) { return _mm512_maskz_cvtepi64_epi32(0xFF, q); }
+    static I join(__m256i lo, __m256i hi) { return _mm512_maskz_inserti64x4(0xFF, _mm512_castsi256_si512(lo), hi, 1); }
 };
 #endif
 
