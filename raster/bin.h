@@ -30,6 +30,9 @@ struct TileGrid {
     int count() const { return tiles_x * tiles_y; }
 };
 
+// BinJob::tile_cover's unit: 1/kCoverScale pixel.
+constexpr std::uint64_t kCoverScale = 2 * std::uint64_t(kSubPixelScale) * std::uint64_t(kSubPixelScale);
+
 struct BinJob {
     std::vector<TriangleSetup> setups;
     std::vector<LineSetup> lines;            // a job of a line or point draw: its items index these
@@ -37,10 +40,17 @@ struct BinJob {
     std::vector<std::uint64_t> pairs;        // (tile << 32 | setup index), before sorting
     std::vector<std::uint32_t> tile_offsets; // tiles + 1
     std::vector<std::uint32_t> items;        // setup indices grouped by tile
+    // Per tile, the area its triangles are estimated to cover there (the
+    // tile pass's overdraw estimate, frame.h), in 1/131072 pixel: a triangle
+    // inside one tile brings its area, one that spans several half its box's
+    // part in each. Integers, so that the frame's sum over jobs is exact
+    // whatever the jobs. Summed here, where the setups are still in cache.
+    std::vector<std::uint64_t> tile_cover;
     std::vector<std::uint32_t> scratch_cursor;
     FrameStats stats;
 
-    void reset() {
+    void reset(int tile_count) {
+        tile_cover.assign(std::size_t(tile_count), 0);
         setups.clear();
         lines.clear();
         clip_pool.clear();
@@ -60,6 +70,8 @@ inline void bin_triangle(BinJob& job, std::uint32_t index, const TileGrid& grid,
     if (tx0 == tx1 && ty0 == ty1) {
         const std::uint32_t tile = std::uint32_t(ty0 * grid.tiles_x + tx0);
         job.pairs.push_back((std::uint64_t(tile) << 32) | index);
+        // area = twice-area / 131072 rounded to a float: times 131072 an integer.
+        job.tile_cover[tile] += std::uint64_t(double(t.area) * double(kCoverScale));
         on_bin(tile);
         return;
     }
@@ -74,6 +86,9 @@ inline void bin_triangle(BinJob& job, std::uint32_t index, const TileGrid& grid,
                 continue;
             std::uint32_t tile = std::uint32_t(ty * grid.tiles_x + tx);
             job.pairs.push_back((std::uint64_t(tile) << 32) | index);
+            const int w = std::min(t.maxx, std::min(x + grid.tile_size, grid.width) - 1) - std::max(t.minx, x) + 1;
+            const int h = std::min(t.maxy, std::min(y + grid.tile_size, grid.height) - 1) - std::max(t.miny, y) + 1;
+            job.tile_cover[tile] += std::uint64_t(w) * std::uint64_t(h) * (kCoverScale / 2);
             on_bin(tile);
         }
 }

@@ -146,7 +146,7 @@ void Renderer::finish(TileHook hook, void* user) {
     pool_.run(job_count, [&](int j, int) {
         BinJob& job = jobs_[std::size_t(j)];
         const JobRange& r = ranges[std::size_t(j)];
-        job.reset();
+        job.reset(tiles);
         if (draws_[std::size_t(r.draw)]->state.topology == Topology::Triangles) job.setups.reserve(r.end - r.begin);
         else job.lines.reserve(r.end - r.begin);
         draws_[std::size_t(r.draw)]->bin(job, r.begin, r.end, grid_, extent);
@@ -313,26 +313,14 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
     // draws always take the pass, so that their events do not depend on tiling.
     bool defer = options_.visibility == FrameOptions::Visibility::Always;
     if (options_.visibility == FrameOptions::Visibility::Auto) {
-        float covered = 0.0f;
+        std::uint64_t covered = 0;  // 1/kCoverScale pixel
         for (const std::unique_ptr<raster_detail::DrawRecord>& dp : draws_) {
             if (dp->mode != raster_detail::DrawMode::Visible) continue;
             defer |= dp->observed;
-            for (int j = dp->first_job; j < dp->first_job + dp->job_count; ++j) {
-                const BinJob& job = jobs_[std::size_t(j)];
-                for (std::uint32_t i = job.tile_offsets[std::size_t(tile)]; i < job.tile_offsets[std::size_t(tile) + 1]; ++i) {
-                    const TriangleSetup& t = job.setups[job.items[i]];
-                    if (t.minx >= r.x0 && t.maxx <= r.x1 && t.miny >= r.y0 && t.maxy <= r.y1) {
-                        covered += t.area;
-                    } else {
-                        // Half the part of its box inside the tile.
-                        const int w = std::min(t.maxx, r.x1) - std::max(t.minx, r.x0) + 1;
-                        const int h = std::min(t.maxy, r.y1) - std::max(t.miny, r.y0) + 1;
-                        covered += 0.5f * float(w) * float(h);
-                    }
-                }
-            }
+            for (int j = dp->first_job; j < dp->first_job + dp->job_count; ++j)
+                covered += jobs_[std::size_t(j)].tile_cover[std::size_t(tile)];
         }
-        defer |= covered > kOverdrawForVisibility * float(r.width()) * float(r.height());
+        defer |= double(covered) > double(kOverdrawForVisibility) * double(kCoverScale) * double(r.width()) * double(r.height());
     }
 
     // Every draw's bins, in submission order.
