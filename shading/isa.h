@@ -16,6 +16,15 @@
 #define PRAST_CALLS_AVX512 0
 #endif
 
+// This file is the AVX-512 copy, which calls the 8-bit fetch's VBMI copy
+// (shading/sample_lanes_vbmi.cpp: sRGB decode by byte permutes, not
+// gathers) where the CPU has AVX512_VBMI.
+#if defined(PRAST_AVX512_DISPATCH) && defined(PRAST_SIMD16) && !defined(__AVX512VBMI__)
+#define PRAST_CALLS_VBMI 1
+#else
+#define PRAST_CALLS_VBMI 0
+#endif
+
 namespace prast {
 
 // Tags for the instruction set a lane loop is instantiated for: the copy
@@ -23,6 +32,7 @@ namespace prast {
 // linker would keep either, and run it on any CPU).
 struct IsaDefault {};
 struct IsaAvx512 {};
+struct IsaAvx512Vbmi {};  // the 8-bit fetch alone, also with AVX512_VBMI
 
 #if PRAST_CALLS_AVX512
 // The CPU runs AVX-512 (F, BW, DQ, VL) and PRAST_AVX512 is not 0 in the
@@ -30,8 +40,15 @@ struct IsaAvx512 {};
 bool use_avx512();
 #endif
 
-// The lane code the 4x4 blocks run in this process: "avx512", "avx2",
-// "neon" or "portable" (render --stats prints it).
+#if defined(PRAST_AVX512_DISPATCH)
+// use_avx512(), the CPU has AVX512_VBMI too, and PRAST_VBMI is not 0 in the
+// environment; read once.
+bool use_avx512_vbmi();
+#endif
+
+// The lane code the 4x4 blocks run in this process: "avx512-vbmi" (the
+// AVX-512 copy with the 8-bit fetch's VBMI copy), "avx512", "avx2", "neon"
+// or "portable" (render --stats prints it).
 const char* lane_isa();
 
 } // namespace prast

@@ -91,6 +91,25 @@ void prepare_trilinear_lanes16_avx512(const Texture& tex, const float* u, const 
                                       const std::uint8_t* quad, std::uint32_t live, TrilinearLanes& out);
 #endif
 
+#if PRAST_CALLS_VBMI
+// The 16-lane 8-bit fetch compiled with AVX512_VBMI too
+// (shading/sample_lanes_vbmi.cpp), for textures vbmi_serves(): the same
+// integers per lane, the sRGB codes looked up by byte permutes.
+void fetch_unorm8_lanes16_vbmi(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components);
+
+// Three or four stored channels, whose sRGB ones decode with the sRGB table.
+inline bool vbmi_serves(const Texture& tex) {
+    if (tex.channels() < 3) return false;
+    bool any = false;
+    for (int c = 0; c < tex.channels(); ++c) {
+        if (!tex.srgb(c)) continue;
+        if (tex.code_table(c) != texture_detail::srgb_code_table()) return false;
+        any = true;
+    }
+    return any;
+}
+#endif
+
 // One mip level per lane (its quad's).
 struct LevelLanes {
     alignas(64) float fw[kMaxN], fh[kMaxN];
@@ -324,6 +343,54 @@ inline typename V::I channel_codes(typename V::I words, int c, const std::uint16
                     V::set1_i(0xFFFF));
 }
 
+#if defined(__AVX512VBMI__)
+// The sRGB code table (texture_detail::srgb_code_table()) as the low and the
+// high bytes of its 256 codes: a byte permute looks up 128 entries at once.
+struct SrgbCodeBytes {
+    alignas(64) std::uint8_t lo[256], hi[256];
+};
+template <class Isa>
+inline const SrgbCodeBytes& srgb_code_bytes() {
+    static const SrgbCodeBytes bytes = [] {
+        SrgbCodeBytes b;
+        const std::uint16_t* t = texture_detail::srgb_code_table();
+        for (int i = 0; i < 256; ++i) {
+            b.lo[i] = std::uint8_t(t[i] & 0xFFu);
+            b.hi[i] = std::uint8_t(t[i] >> 8);
+        }
+        return b;
+    }();
+    return bytes;
+}
+
+// The sRGB codes of all four bytes of the 16 words: code[c] holds byte c's
+// (texel channel c) in lane order. Four byte permutes (two a half of the
+// table) and a blend by the bytes' top bit look up the 64 bytes' low and
+// high code bytes, which unpack into words, then into each channel's lanes.
+template <class Isa>
+[[gnu::always_inline]] inline void srgb_codes_vbmi(__m512i w, const SrgbCodeBytes& t, __m512i* code) {
+    const __mmask64 upper = _mm512_movepi8_mask(w);
+    auto look = [&](const std::uint8_t* tab) __attribute__((always_inline)) {
+        const __m512i below = _mm512_permutex2var_epi8(_mm512_load_si512(tab), w, _mm512_load_si512(tab + 64));
+        const __m512i above = _mm512_permutex2var_epi8(_mm512_load_si512(tab + 128), w, _mm512_load_si512(tab + 192));
+        return _mm512_mask_blend_epi8(upper, below, above);
+    };
+    const __m512i lo = look(t.lo), hi = look(t.hi);
+    // Per 128 bits (lanes 4k..4k+3): the codes of lanes 4k, 4k+1, then of 4k+2, 4k+3.
+    const __m512i first = _mm512_unpacklo_epi8(lo, hi), second = _mm512_unpackhi_epi8(lo, hi);
+    // Channels 0 and 1 of lane 4k + j: dword 4k + 2j of `first` (j < 2), of `second` (16 + 4k + 2(j - 2)).
+    const __m512i pick01 = _mm512_setr_epi32(0, 2, 16, 18, 4, 6, 20, 22, 8, 10, 24, 26, 12, 14, 28, 30);
+    const __m512i pick23 = _mm512_add_epi32(pick01, _mm512_set1_epi32(1));
+    const __m512i c01 = _mm512_permutex2var_epi32(first, pick01, second);
+    const __m512i c23 = _mm512_permutex2var_epi32(first, pick23, second);
+    const __m512i low16 = _mm512_set1_epi32(0xFFFF);
+    code[0] = _mm512_and_si512(c01, low16);
+    code[1] = _mm512_maskz_srli_epi32(0xFFFF, c01, 16);
+    code[2] = _mm512_and_si512(c23, low16);
+    code[3] = _mm512_maskz_srli_epi32(0xFFFF, c23, 16);
+}
+#endif
+
 // texture_detail::weight8 / lerp8 / narrow8, per lane. A lerp is one
 // multiply-add of the 16-bit pairs (a, b) and (256 - w, w): the codes are at
 // most 32640 and the weights 256, inside madd's signed 16-bit inputs.
@@ -342,7 +409,7 @@ template <class V> inline typename V::I narrow8(typename V::I x) {
 
 // Bilinear filter of every needed stored channel of one level for lanes
 // [l0, l0 + W): Texture::fix_bilinear() per lane.
-template <class V, int C>
+template <class V, int C, class Isa>
 [[gnu::always_inline]] inline void bilinear_unorm8(const Texture& tex, const std::uint16_t* const* srgb_codes, unsigned need,
                                                    const std::int32_t (*idx)[kMaxN], const float* tx_lanes,
                                                    const float* ty_lanes, int l0, typename V::I* result) {
@@ -365,11 +432,31 @@ template <class V, int C>
     }
     const I wx = weight_pairs<V>(weight8<V>(V::load_f(tx_lanes + l0)));
     const I wy = weight_pairs<V>(weight8<V>(V::load_f(ty_lanes + l0)));
+#if defined(__AVX512VBMI__)
+    // Every sRGB channel's codes from the permutes (vbmi_serves()).
+    constexpr bool kVbmi = std::is_same_v<Isa, IsaAvx512Vbmi>;
+    [[maybe_unused]] I pa[4], pb[4], pc[4], pd[4];
+    if constexpr (kVbmi) {
+        const SrgbCodeBytes& table = srgb_code_bytes<Isa>();
+        srgb_codes_vbmi<Isa>(wa, table, pa);
+        srgb_codes_vbmi<Isa>(wb, table, pb);
+        srgb_codes_vbmi<Isa>(wc, table, pc);
+        srgb_codes_vbmi<Isa>(wd, table, pd);
+    }
+#endif
     for (int c = 0; c < C; ++c) {
         if (!((need >> c) & 1u)) continue;
         const std::uint16_t* codes = srgb_codes[c];
-        const I a = channel_codes<V>(wa, c, codes), b = channel_codes<V>(wb, c, codes);
-        const I cc = channel_codes<V>(wc, c, codes), d = channel_codes<V>(wd, c, codes);
+        I a, b, cc, d;
+#if defined(__AVX512VBMI__)
+        if (kVbmi && codes) {
+            a = pa[c]; b = pb[c]; cc = pc[c]; d = pd[c];
+        } else
+#endif
+        {
+            a = channel_codes<V>(wa, c, codes); b = channel_codes<V>(wb, c, codes);
+            cc = channel_codes<V>(wc, c, codes); d = channel_codes<V>(wd, c, codes);
+        }
         const I top = narrow8<V>(lerp8<V>(a, b, wx));
         const I bottom = narrow8<V>(lerp8<V>(cc, d, wx));
         result[c] = lerp8<V>(top, bottom, wy);
@@ -379,7 +466,7 @@ template <class V, int C>
 // All N lanes of an 8-bit texture, W at a time; non-live lanes get 0. Only
 // the output components in `components` (bit k: r, g, b, a) are written, and
 // only the stored channels they need are read.
-template <int N, int W, int C>
+template <int N, int W, int C, class Isa>
 inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components) {
     using V = Simd<W>;
     using F = typename V::F;
@@ -399,11 +486,11 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
         }
         const I izero = V::set1_i(0);
         I res[4] = {izero, izero, izero, izero};
-        bilinear_unorm8<V, C>(tex, srgb_codes, need, at.ia, at.txa, at.tya, l0, res);
+        bilinear_unorm8<V, C, Isa>(tex, srgb_codes, need, at.ia, at.txa, at.tya, l0, res);
         const unsigned blend = (at.blend >> l0) & ((1u << W) - 1u);
         if (blend) {
             I resb[4] = {izero, izero, izero, izero};
-            bilinear_unorm8<V, C>(tex, srgb_codes, need, at.ib, at.txb, at.tyb, l0, resb);
+            bilinear_unorm8<V, C, Isa>(tex, srgb_codes, need, at.ib, at.txb, at.tyb, l0, resb);
             const I wt = weight_pairs<V>(weight8<V>(V::load_f(at.t + l0)));
             const I mask = V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits());
             for (int c = 0; c < C; ++c)
@@ -448,11 +535,19 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
         }
     }
 #endif
+#if PRAST_CALLS_VBMI
+    if constexpr (N == 16 && std::is_same_v<Isa, IsaAvx512>) {
+        if (use_avx512_vbmi() && vbmi_serves(tex)) {
+            fetch_unorm8_lanes16_vbmi(tex, at, out, components);
+            return;
+        }
+    }
+#endif
     switch (tex.channels()) {
-    case 1: fetch_unorm8_lanes<N, W, 1>(tex, at, out, components); return;
-    case 2: fetch_unorm8_lanes<N, W, 2>(tex, at, out, components); return;
-    case 3: fetch_unorm8_lanes<N, W, 3>(tex, at, out, components); return;
-    default: fetch_unorm8_lanes<N, W, 4>(tex, at, out, components); return;
+    case 1: fetch_unorm8_lanes<N, W, 1, Isa>(tex, at, out, components); return;
+    case 2: fetch_unorm8_lanes<N, W, 2, Isa>(tex, at, out, components); return;
+    case 3: fetch_unorm8_lanes<N, W, 3, Isa>(tex, at, out, components); return;
+    default: fetch_unorm8_lanes<N, W, 4, Isa>(tex, at, out, components); return;
     }
 }
 

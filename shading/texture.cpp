@@ -292,6 +292,7 @@ const CodeTables& code_tables() {
 } // namespace
 
 namespace texture_detail {
+const std::uint16_t* srgb_code_table() { return code_tables().srgb; }
 namespace {
 std::array<float, 257> make_log2_mantissa() {
     std::array<float, 257> t{};

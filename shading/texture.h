@@ -321,6 +321,9 @@ constexpr std::int32_t kFixOne = 255 * 128;         // the code of linear 1.0
 constexpr std::int32_t kFixFull = kFixOne * 256;    // a filtered value before narrowing
 constexpr float kFixFullF = float(kFixFull);        // exact
 
+// The code table of every sRGB channel (Texture::code_table()), 258 entries.
+const std::uint16_t* srgb_code_table();
+
 // A weight in [0, 1] rounded to 8 bits: 0..256 (t * 256 is exact).
 inline std::int32_t weight8(float t) { return std::int32_t(t * 256.0f + 0.5f); }
 // a (256 - w) + b w, for codes a, b <= kFixOne: at most kFixFull.

@@ -1,28 +1,39 @@
 #!/bin/sh
-# The `isa` test: the object compiled for AVX-512
-# (shading/sample_lanes_avx512.cpp) defines only its entry points and
-# templates on 16 lanes or tagged IsaAvx512, which no other object
-# instantiates, so the linker can never pick an AVX-512 copy of an inline
-# function that code for any CPU calls.
+# The `isa` test: the objects compiled for AVX-512
+# (shading/sample_lanes_avx512.cpp) and for AVX-512 with VBMI
+# (shading/sample_lanes_vbmi.cpp) define only their entry points and
+# templates tagged for them (or, for the first, on 16 lanes), which no other
+# object instantiates, so the linker can never pick such a copy of an inline
+# function that code for a CPU without those instructions calls.
 #   sh tests/check_isa.sh OBJECT...   (the prast_shading objects; others are skipped)
 set -e
-obj=""
+avx512="" vbmi=""
 for o in "$@"; do
-  case "$o" in *sample_lanes_avx512.cpp.o) obj="$o" ;; esac
+  case "$o" in
+    *sample_lanes_avx512.cpp.o) avx512="$o" ;;
+    *sample_lanes_vbmi.cpp.o) vbmi="$o" ;;
+  esac
 done
-[ -n "$obj" ] || { echo "isa: no sample_lanes_avx512 object among the arguments"; exit 1; }
+[ -n "$avx512" ] || { echo "isa: no sample_lanes_avx512 object among the arguments"; exit 1; }
+[ -n "$vbmi" ] || { echo "isa: no sample_lanes_vbmi object among the arguments"; exit 1; }
+list="${TMPDIR:-/tmp}/isa-symbols.$$"
+trap 'rm -f "$list"' EXIT
 # Code other objects can bind to: global (T), weak (W) and indirect (i)
 # functions. Local symbols (t) and data are no hazard.
-nm -C --defined-only "$obj" | awk '$2 ~ /^[TWi]$/' > "${TMPDIR:-/tmp}/isa-symbols.$$"
-trap 'rm -f "${TMPDIR:-/tmp}/isa-symbols.$$"' EXIT
-grep -q 'fetch_unorm8_lanes16_avx512' "${TMPDIR:-/tmp}/isa-symbols.$$" || { echo "isa: $obj lacks its entry point"; exit 1; }
-bad=$(grep -v -e 'fetch_unorm8_lanes16_avx512' -e 'prepare_trilinear_lanes16_avx512' -e 'sample_material_lanes16_avx512' \
-  -e 'shade_block_lanes16_avx512' \
-  -e 'fetch_unorm8_lanes<16, 16, [1-4]>' -e 'Simd<16>' -e 'IsaAvx512' \
-  "${TMPDIR:-/tmp}/isa-symbols.$$" || true)
-if [ -n "$bad" ]; then
-  echo "isa: $obj defines code other files may share (it would run AVX-512 on any CPU):"
-  echo "$bad"
-  exit 1
-fi
-echo "isa: $(wc -l < "${TMPDIR:-/tmp}/isa-symbols.$$") symbols, all AVX-512-only"
+# check OBJECT ENTRY PATTERN...: ENTRY defined, every symbol matches a PATTERN.
+check() {
+  obj=$1 entry=$2
+  shift 2
+  nm -C --defined-only "$obj" | awk '$2 ~ /^[TWi]$/' > "$list"
+  grep -q "$entry" "$list" || { echo "isa: $obj lacks its entry point $entry"; exit 1; }
+  bad=$(grep -v "$@" "$list" || true)
+  if [ -n "$bad" ]; then
+    echo "isa: $obj defines code other files may share (it would run its instructions on any CPU):"
+    echo "$bad"
+    exit 1
+  fi
+  echo "isa: $(basename "$obj"): $(wc -l < "$list") symbols, all its own"
+}
+check "$avx512" fetch_unorm8_lanes16_avx512 -e 'fetch_unorm8_lanes16_avx512' -e 'prepare_trilinear_lanes16_avx512' \
+  -e 'sample_material_lanes16_avx512' -e 'shade_block_lanes16_avx512' -e 'Simd<16>' -e 'IsaAvx512'
+check "$vbmi" fetch_unorm8_lanes16_vbmi -e 'fetch_unorm8_lanes16_vbmi' -e 'IsaAvx512Vbmi'

@@ -392,13 +392,18 @@ TEST_CASE("--repeat prints frame_ms min/median/max and --stats the counters") {
         CHECK(s.out.find(key) != std::string::npos);
     CHECK(s.out.find("frame_ms") == std::string::npos);
     // The lane code that ran: the build's, or AVX-512's copy where the CPU
-    // has it, which PRAST_AVX512=0 turns off.
+    // has it, which PRAST_AVX512=0 turns off (and its fetch's VBMI copy,
+    // which PRAST_VBMI=0 turns off).
     const std::string lanes = std::string("lanes                  ") + lane_isa() + "\n";
     CHECK(s.out.find(lanes) != std::string::npos);
 #ifndef PRAST_SIMD16
-    if (std::string(lane_isa()) == "avx512") {
+    if (std::string(lane_isa()).rfind("avx512", 0) == 0) {
         CliRun off = box.run_exe(PRAST_RENDER_EXE, with(kSmall, {"--stats"}), "export PRAST_AVX512=0");
         CHECK(off.out.find("lanes                  avx2\n") != std::string::npos);
+    }
+    if (std::string(lane_isa()) == "avx512-vbmi") {
+        CliRun off = box.run_exe(PRAST_RENDER_EXE, with(kSmall, {"--stats"}), "export PRAST_VBMI=0");
+        CHECK(off.out.find("lanes                  avx512\n") != std::string::npos);
     }
 #endif
     // The repeated and the single render wrote the same image.
