@@ -94,19 +94,16 @@ void prepare_trilinear_lanes16_avx512(const Texture& tex, const float* u, const 
 #if PRAST_CALLS_VBMI
 // The 16-lane 8-bit fetch compiled with AVX512_VBMI too
 // (shading/sample_lanes_vbmi.cpp), for textures vbmi_serves(): the same
-// integers per lane, the sRGB codes looked up by byte permutes.
+// integers per lane, each channel's pair of taps picked from the gathered
+// qwords and the sRGB codes looked up by byte permutes.
 void fetch_unorm8_lanes16_vbmi(const Texture& tex, const TrilinearLanes& at, TexelLanes& out, unsigned components);
 
 // Three or four stored channels, whose sRGB ones decode with the sRGB table.
 inline bool vbmi_serves(const Texture& tex) {
     if (tex.channels() < 3) return false;
-    bool any = false;
-    for (int c = 0; c < tex.channels(); ++c) {
-        if (!tex.srgb(c)) continue;
-        if (tex.code_table(c) != texture_detail::srgb_code_table()) return false;
-        any = true;
-    }
-    return any;
+    for (int c = 0; c < tex.channels(); ++c)
+        if (tex.srgb(c) && tex.code_table(c) != texture_detail::srgb_code_table()) return false;
+    return true;
 }
 #endif
 
@@ -391,6 +388,95 @@ template <class Isa>
 }
 #endif
 
+#if defined(__AVX512VBMI__)
+// A lane's two taps of one row (texels x0 and x1) as the qword read at x0,
+// 16 lanes in two registers of eight, for 3 or 4 bytes a texel.
+template <class Isa, int C>
+[[gnu::always_inline]] inline void pair_qwords(const std::uint8_t* base, __m512i idx, __m512i* q) {
+    const __m512i offset = C == 3 ? _mm512_add_epi32(idx, _mm512_add_epi32(idx, idx)) : idx;
+    constexpr int kScale = C == 3 ? 1 : 4;
+    q[0] = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_maskz_extracti64x4_epi64(0xF, offset, 0),
+                                       base, kScale);
+    q[1] = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_maskz_extracti64x4_epi64(0xF, offset, 1),
+                                       base, kScale);
+}
+
+// Byte indices into two registers (128 bytes) that put, in dword l, the
+// bytes `first` and `second` of lane l's qword (of 8: lanes 0-7 in the first
+// register, 8-15 in the second; with `codes`, lane l % 8's, and `second`
+// names the high code byte of `first`).
+struct PairPick {
+    alignas(64) std::uint8_t index[64];
+};
+constexpr PairPick pair_bytes(int x0, int x1) {  // dword l: [x0, -, x1, -] of lane l's qword
+    PairPick p{};
+    for (int l = 0; l < 16; ++l) {
+        const int q = (l / 8) * 64 + (l % 8) * 8;
+        p.index[4 * l] = std::uint8_t(q + x0);
+        p.index[4 * l + 2] = std::uint8_t(q + x1);
+    }
+    return p;
+}
+constexpr PairPick pair_codes(int x0, int x1) {  // dword l: [lo(x0), hi(x0), lo(x1), hi(x1)] of lane l % 8
+    PairPick p{};
+    for (int l = 0; l < 16; ++l) {
+        const int q = (l % 8) * 8;
+        p.index[4 * l] = std::uint8_t(q + x0);
+        p.index[4 * l + 1] = std::uint8_t(64 + q + x0);
+        p.index[4 * l + 2] = std::uint8_t(q + x1);
+        p.index[4 * l + 3] = std::uint8_t(64 + q + x1);
+    }
+    return p;
+}
+template <int C, int c> struct PairIndex {
+    static constexpr PairPick bytes = pair_bytes(c, C + c);
+    static constexpr PairPick codes = pair_codes(c, C + c);
+};
+
+// The sRGB code bytes of the 64 bytes of q: lo, hi (as srgb_codes_vbmi).
+template <class Isa>
+[[gnu::always_inline]] inline void code_bytes(__m512i q, const SrgbCodeBytes& t, __m512i& lo, __m512i& hi) {
+    const __mmask64 upper = _mm512_movepi8_mask(q);
+    auto look = [&](const std::uint8_t* tab) __attribute__((always_inline)) {
+        const __m512i below = _mm512_permutex2var_epi8(_mm512_load_si512(tab), q, _mm512_load_si512(tab + 64));
+        const __m512i above = _mm512_permutex2var_epi8(_mm512_load_si512(tab + 128), q, _mm512_load_si512(tab + 192));
+        return _mm512_mask_blend_epi8(upper, below, above);
+    };
+    lo = look(t.lo);
+    hi = look(t.hi);
+}
+
+// (code of x0) | (code of x1) << 16 of stored channel c, per lane: lerp8's
+// pair, from the qwords q (linear: byte * 128) or their code bytes lo, hi.
+template <class Isa, int C, int c>
+[[gnu::always_inline]] inline __m512i pair_linear(const __m512i* q) {
+    const __m512i idx = _mm512_load_si512(PairIndex<C, c>::bytes.index);
+    return _mm512_maskz_slli_epi32(0xFFFF, _mm512_maskz_permutex2var_epi8(0x5555555555555555ull, q[0], idx, q[1]), 7);
+}
+template <class Isa, int C, int c>
+[[gnu::always_inline]] inline __m512i pair_srgb(const __m512i* lo, const __m512i* hi) {
+    const __m512i idx = _mm512_load_si512(PairIndex<C, c>::codes.index);
+    return _mm512_mask_blend_epi32(0xFF00, _mm512_permutex2var_epi8(lo[0], idx, hi[0]),
+                                   _mm512_permutex2var_epi8(lo[1], idx, hi[1]));
+}
+
+// bilinear_unorm8's x-lerp pairs without splitting the gathered qwords: each
+// channel's (x0, x1) codes of a row come from one or two byte permutes of
+// them (or of their sRGB code bytes); the same integers as the split path.
+template <class Isa, int C, int c>
+[[gnu::always_inline]] inline void pair_rows_vbmi(const __m512i* qa, const __m512i* qc, const __m512i* la,
+                                                  const __m512i* ha, const __m512i* lc, const __m512i* hc, bool srgb,
+                                                  __m512i& top, __m512i& bottom) {
+    if (srgb) {
+        top = pair_srgb<Isa, C, c>(la, ha);
+        bottom = pair_srgb<Isa, C, c>(lc, hc);
+    } else {
+        top = pair_linear<Isa, C, c>(qa);
+        bottom = pair_linear<Isa, C, c>(qc);
+    }
+}
+#endif
+
 // texture_detail::weight8 / lerp8 / narrow8, per lane. A lerp is one
 // multiply-add of the 16-bit pairs (a, b) and (256 - w, w): the codes are at
 // most 32640 and the weights 256, inside madd's signed 16-bit inputs.
@@ -420,8 +506,41 @@ template <class V, int C, class Isa>
     // Unless a lane's footprint wraps or clamps at a row's end, its right taps
     // follow its left ones in memory: half the gathered elements.
     const I one = V::set1_i(1);
+    const bool pairs = V::all_i(V::and_i(V::cmpeq_i(ib, V::add_i(ia, one)), V::cmpeq_i(id, V::add_i(ic, one))));
+    const I wx = weight_pairs<V>(weight8<V>(V::load_f(tx_lanes + l0)));
+    const I wy = weight_pairs<V>(weight8<V>(V::load_f(ty_lanes + l0)));
+#if defined(__AVX512VBMI__)
+    if constexpr (std::is_same_v<Isa, IsaAvx512Vbmi> && (C == 3 || C == 4)) {
+        if (pairs) {
+            I qa[2], qc[2], la[2] = {}, ha[2] = {}, lc[2] = {}, hc[2] = {};
+            pair_qwords<Isa, C>(base, ia, qa);
+            pair_qwords<Isa, C>(base, ic, qc);
+            bool any_srgb = false;
+            for (int c = 0; c < C; ++c) any_srgb |= ((need >> c) & 1u) && srgb_codes[c];
+            if (any_srgb) {
+                const SrgbCodeBytes& table = srgb_code_bytes<Isa>();
+                for (int k = 0; k < 2; ++k) {
+                    code_bytes<Isa>(qa[k], table, la[k], ha[k]);
+                    code_bytes<Isa>(qc[k], table, lc[k], hc[k]);
+                }
+            }
+            auto channel = [&](auto cc) __attribute__((always_inline)) {
+                constexpr int c = decltype(cc)::value;
+                if (!((need >> c) & 1u)) return;
+                I top, bottom;
+                pair_rows_vbmi<Isa, C, c>(qa, qc, la, ha, lc, hc, srgb_codes[c] != nullptr, top, bottom);
+                result[c] = lerp8<V>(narrow8<V>(V::madd_i(top, wx)), narrow8<V>(V::madd_i(bottom, wx)), wy);
+            };
+            channel(std::integral_constant<int, 0>());
+            channel(std::integral_constant<int, 1>());
+            channel(std::integral_constant<int, 2>());
+            if constexpr (C == 4) channel(std::integral_constant<int, 3>());
+            return;
+        }
+    }
+#endif
     I wa, wb, wc, wd;
-    if (V::all_i(V::and_i(V::cmpeq_i(ib, V::add_i(ia, one)), V::cmpeq_i(id, V::add_i(ic, one))))) {
+    if (pairs) {
         gather_texel_pairs<V, C>(base, ia, wa, wb);
         gather_texel_pairs<V, C>(base, ic, wc, wd);
     } else {
@@ -430,13 +549,13 @@ template <class V, int C, class Isa>
         wc = gather_texels<V, C>(base, ic);
         wd = gather_texels<V, C>(base, id);
     }
-    const I wx = weight_pairs<V>(weight8<V>(V::load_f(tx_lanes + l0)));
-    const I wy = weight_pairs<V>(weight8<V>(V::load_f(ty_lanes + l0)));
 #if defined(__AVX512VBMI__)
     // Every sRGB channel's codes from the permutes (vbmi_serves()).
     constexpr bool kVbmi = std::is_same_v<Isa, IsaAvx512Vbmi>;
-    [[maybe_unused]] I pa[4], pb[4], pc[4], pd[4];
-    if constexpr (kVbmi) {
+    [[maybe_unused]] I pa[4] = {}, pb[4] = {}, pc[4] = {}, pd[4] = {};
+    bool any_srgb = false;
+    for (int c = 0; c < C; ++c) any_srgb |= ((need >> c) & 1u) && srgb_codes[c];
+    if (kVbmi && any_srgb) {
         const SrgbCodeBytes& table = srgb_code_bytes<Isa>();
         srgb_codes_vbmi<Isa>(wa, table, pa);
         srgb_codes_vbmi<Isa>(wb, table, pb);
