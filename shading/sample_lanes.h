@@ -360,19 +360,27 @@ inline const SrgbCodeBytes& srgb_code_bytes() {
     return bytes;
 }
 
-// The sRGB codes of all four bytes of the 16 words: code[c] holds byte c's
-// (texel channel c) in lane order. Four byte permutes (two a half of the
-// table) and a blend by the bytes' top bit look up the 64 bytes' low and
-// high code bytes, which unpack into words, then into each channel's lanes.
+// The sRGB codes of the 64 bytes of q, as their low and high bytes: four
+// byte permutes (two a half of the table) and a blend by the bytes' top bit.
 template <class Isa>
-[[gnu::always_inline]] inline void srgb_codes_vbmi(__m512i w, const SrgbCodeBytes& t, __m512i* code) {
-    const __mmask64 upper = _mm512_movepi8_mask(w);
+[[gnu::always_inline]] inline void code_bytes(__m512i q, const SrgbCodeBytes& t, __m512i& lo, __m512i& hi) {
+    const __mmask64 upper = _mm512_movepi8_mask(q);
     auto look = [&](const std::uint8_t* tab) __attribute__((always_inline)) {
-        const __m512i below = _mm512_permutex2var_epi8(_mm512_load_si512(tab), w, _mm512_load_si512(tab + 64));
-        const __m512i above = _mm512_permutex2var_epi8(_mm512_load_si512(tab + 128), w, _mm512_load_si512(tab + 192));
+        const __m512i below = _mm512_permutex2var_epi8(_mm512_load_si512(tab), q, _mm512_load_si512(tab + 64));
+        const __m512i above = _mm512_permutex2var_epi8(_mm512_load_si512(tab + 128), q, _mm512_load_si512(tab + 192));
         return _mm512_mask_blend_epi8(upper, below, above);
     };
-    const __m512i lo = look(t.lo), hi = look(t.hi);
+    lo = look(t.lo);
+    hi = look(t.hi);
+}
+
+// The sRGB codes of all four bytes of the 16 words: code[c] holds byte c's
+// (texel channel c) in lane order: the 64 bytes' code bytes (code_bytes)
+// unpacked into words, then into each channel's lanes.
+template <class Isa>
+[[gnu::always_inline]] inline void srgb_codes_vbmi(__m512i w, const SrgbCodeBytes& t, __m512i* code) {
+    __m512i lo, hi;
+    code_bytes<Isa>(w, t, lo, hi);
     // Per 128 bits (lanes 4k..4k+3): the codes of lanes 4k, 4k+1, then of 4k+2, 4k+3.
     const __m512i first = _mm512_unpacklo_epi8(lo, hi), second = _mm512_unpackhi_epi8(lo, hi);
     // Channels 0 and 1 of lane 4k + j: dword 4k + 2j of `first` (j < 2), of `second` (16 + 4k + 2(j - 2)).
@@ -386,9 +394,7 @@ template <class Isa>
     code[2] = _mm512_and_si512(c23, low16);
     code[3] = _mm512_maskz_srli_epi32(0xFFFF, c23, 16);
 }
-#endif
 
-#if defined(__AVX512VBMI__)
 // A lane's two taps of one row (texels x0 and x1) as the qword read at x0,
 // 16 lanes in two registers of eight, for 3 or 4 bytes a texel.
 template <class Isa, int C>
@@ -401,10 +407,12 @@ template <class Isa, int C>
                                        base, kScale);
 }
 
-// Byte indices into two registers (128 bytes) that put, in dword l, the
-// bytes `first` and `second` of lane l's qword (of 8: lanes 0-7 in the first
-// register, 8-15 in the second; with `codes`, lane l % 8's, and `second`
-// names the high code byte of `first`).
+// Byte indices for a permute of two registers (128 bytes) that puts a
+// lane's texel x0 and x1 bytes of one channel in bytes 0 and 2 of its dword:
+// pair_bytes() picks from the gathered qwords (lanes 0-7 in the first
+// register, 8-15 in the second), pair_codes() from one register's code
+// bytes (the low ones first, the high ones second), each code byte followed
+// by its high byte.
 struct PairPick {
     alignas(64) std::uint8_t index[64];
 };
@@ -432,19 +440,6 @@ template <int C, int c> struct PairIndex {
     static constexpr PairPick bytes = pair_bytes(c, C + c);
     static constexpr PairPick codes = pair_codes(c, C + c);
 };
-
-// The sRGB code bytes of the 64 bytes of q: lo, hi (as srgb_codes_vbmi).
-template <class Isa>
-[[gnu::always_inline]] inline void code_bytes(__m512i q, const SrgbCodeBytes& t, __m512i& lo, __m512i& hi) {
-    const __mmask64 upper = _mm512_movepi8_mask(q);
-    auto look = [&](const std::uint8_t* tab) __attribute__((always_inline)) {
-        const __m512i below = _mm512_permutex2var_epi8(_mm512_load_si512(tab), q, _mm512_load_si512(tab + 64));
-        const __m512i above = _mm512_permutex2var_epi8(_mm512_load_si512(tab + 128), q, _mm512_load_si512(tab + 192));
-        return _mm512_mask_blend_epi8(upper, below, above);
-    };
-    lo = look(t.lo);
-    hi = look(t.hi);
-}
 
 // (code of x0) | (code of x1) << 16 of stored channel c, per lane: lerp8's
 // pair, from the qwords q (linear: byte * 128) or their code bytes lo, hi.
