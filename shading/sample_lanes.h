@@ -534,6 +534,25 @@ template <class V, int C, class Isa>
         }
     }
 #endif
+    if constexpr (C <= 2) {
+        // One 4-byte read holds both taps of a row: each linear channel's
+        // (x0, x1) bytes move into the low bytes of the two words by one
+        // byte shuffle, and times 128 they are lerp8's code pair.
+        bool linear = true;
+        for (int c = 0; c < C; ++c) linear &= !((need >> c) & 1u) || !srgb_codes[c];
+        if (pairs && linear) {
+            const I ra = V::template gather_i<C>(base, ia), rc = V::template gather_i<C>(base, ic);
+            for (int c = 0; c < C; ++c) {
+                if (!((need >> c) & 1u)) continue;
+                const I pick = V::add_i(V::set1_i(int(0x80808080u & ~0x00FF00FFu) | c | ((C + c) << 16)),
+                                        V::dword_byte_offsets());
+                const I top = V::template slli_i<7>(V::shuffle_bytes(ra, pick));
+                const I bottom = V::template slli_i<7>(V::shuffle_bytes(rc, pick));
+                result[c] = lerp8<V>(narrow8<V>(V::madd_i(top, wx)), narrow8<V>(V::madd_i(bottom, wx)), wy);
+            }
+            return;
+        }
+    }
     I wa, wb, wc, wd;
     if (pairs) {
         gather_texel_pairs<V, C>(base, ia, wa, wb);

@@ -54,6 +54,9 @@ template <> struct Simd<8> {
     static I cvtt(F a) { return _mm256_cvttps_epi32(a); }
     static I select_i(I mask, I yes, I no) { return _mm256_blendv_epi8(no, yes, mask); }
     static I srlv_i(I a, I n) { return _mm256_srlv_epi32(a, n); }
+    static I shuffle_bytes(I a, I idx) { return _mm256_shuffle_epi8(a, idx); }  // within each 16 bytes
+    // 4 (l % 4) in bytes 0 and 2 of lane l: where its dword starts in its 16 bytes.
+    static I dword_byte_offsets() { return _mm256_setr_epi32(0, 0x40004, 0x80008, 0xC000C, 0, 0x40004, 0x80008, 0xC000C); }
     static I cmpeq_i(I a, I b) { return _mm256_cmpeq_epi32(a, b); }
     static F cvt(I a) { return _mm256_cvtepi32_ps(a); }
     static F add(F a, F b) { return _mm256_add_ps(a, b); }
@@ -106,6 +109,8 @@ template <> struct Simd<4> {
     static I cvtt(F a) { return _mm_cvttps_epi32(a); }
     static I select_i(I mask, I yes, I no) { return _mm_blendv_epi8(no, yes, mask); }
     static I srlv_i(I a, I n) { return _mm_srlv_epi32(a, n); }
+    static I shuffle_bytes(I a, I idx) { return _mm_shuffle_epi8(a, idx); }
+    static I dword_byte_offsets() { return _mm_setr_epi32(0, 0x40004, 0x80008, 0xC000C); }
     static I cmpeq_i(I a, I b) { return _mm_cmpeq_epi32(a, b); }
     static F cvt(I a) { return _mm_cvtepi32_ps(a); }
     static F add(F a, F b) { return _mm_add_ps(a, b); }
@@ -176,6 +181,11 @@ template <> struct Simd<16> {
     static I cvtt(F a) { return _mm512_maskz_cvttps_epi32(0xFFFF, a); }
     static I select_i(I mask, I yes, I no) { return _mm512_mask_blend_epi32(_mm512_movepi32_mask(mask), no, yes); }
     static I srlv_i(I a, I n) { return _mm512_maskz_srlv_epi32(0xFFFF, a, n); }
+    static I shuffle_bytes(I a, I idx) { return _mm512_maskz_shuffle_epi8(~0ull, a, idx); }  // within each 16 bytes
+    static I dword_byte_offsets() {
+        return _mm512_setr_epi32(0, 0x40004, 0x80008, 0xC000C, 0, 0x40004, 0x80008, 0xC000C, 0, 0x40004, 0x80008, 0xC000C,
+                                 0, 0x40004, 0x80008, 0xC000C);
+    }
     static I cmpeq_i(I a, I b) { return _mm512_movm_epi32(_mm512_cmpeq_epi32_mask(a, b)); }
     static F cvt(I a) { return _mm512_maskz_cvtepi32_ps(0xFFFF, a); }
     static F add(F a, F b) { return _mm512_add_ps(a, b); }
