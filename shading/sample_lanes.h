@@ -544,8 +544,8 @@ template <class V, int C, class Isa>
             const I ra = V::template gather_i<C>(base, ia), rc = V::template gather_i<C>(base, ic);
             for (int c = 0; c < C; ++c) {
                 if (!((need >> c) & 1u)) continue;
-                const I pick = V::add_i(V::set1_i(int(0x80808080u & ~0x00FF00FFu) | c | ((C + c) << 16)),
-                                        V::dword_byte_offsets());
+                // Bytes c and C + c of the lane's dword to bytes 0 and 2; 0x80 zeroes 1 and 3.
+                const I pick = V::add_i(V::set1_i(int(0x80008000u) | c | ((C + c) << 16)), V::dword_byte_offsets());
                 const I top = V::template slli_i<7>(V::shuffle_bytes(ra, pick));
                 const I bottom = V::template slli_i<7>(V::shuffle_bytes(rc, pick));
                 result[c] = lerp8<V>(narrow8<V>(V::madd_i(top, wx)), narrow8<V>(V::madd_i(bottom, wx)), wy);
