@@ -504,15 +504,15 @@ template <class V, int C, class Isa>
     const bool pairs = V::all_i(V::and_i(V::cmpeq_i(ib, V::add_i(ia, one)), V::cmpeq_i(id, V::add_i(ic, one))));
     const I wx = weight_pairs<V>(weight8<V>(V::load_f(tx_lanes + l0)));
     const I wy = weight_pairs<V>(weight8<V>(V::load_f(ty_lanes + l0)));
+    bool needs_srgb = false;  // a needed channel is sRGB-encoded
+    for (int c = 0; c < C; ++c) needs_srgb |= ((need >> c) & 1u) && srgb_codes[c];
 #if defined(__AVX512VBMI__)
     if constexpr (std::is_same_v<Isa, IsaAvx512Vbmi> && (C == 3 || C == 4)) {
         if (pairs) {
             I qa[2], qc[2], la[2] = {}, ha[2] = {}, lc[2] = {}, hc[2] = {};
             pair_qwords<Isa, C>(base, ia, qa);
             pair_qwords<Isa, C>(base, ic, qc);
-            bool any_srgb = false;
-            for (int c = 0; c < C; ++c) any_srgb |= ((need >> c) & 1u) && srgb_codes[c];
-            if (any_srgb) {
+            if (needs_srgb) {
                 const SrgbCodeBytes& table = srgb_code_bytes<Isa>();
                 for (int k = 0; k < 2; ++k) {
                     code_bytes<Isa>(qa[k], table, la[k], ha[k]);
@@ -538,9 +538,7 @@ template <class V, int C, class Isa>
         // One 4-byte read holds both taps of a row: each linear channel's
         // (x0, x1) bytes move into the low bytes of the two words by one
         // byte shuffle, and times 128 they are lerp8's code pair.
-        bool linear = true;
-        for (int c = 0; c < C; ++c) linear &= !((need >> c) & 1u) || !srgb_codes[c];
-        if (pairs && linear) {
+        if (pairs && !needs_srgb) {
             const I ra = V::template gather_i<C>(base, ia), rc = V::template gather_i<C>(base, ic);
             for (int c = 0; c < C; ++c) {
                 if (!((need >> c) & 1u)) continue;
@@ -567,9 +565,7 @@ template <class V, int C, class Isa>
     // Every sRGB channel's codes from the permutes (vbmi_serves()).
     constexpr bool kVbmi = std::is_same_v<Isa, IsaAvx512Vbmi>;
     [[maybe_unused]] I pa[4] = {}, pb[4] = {}, pc[4] = {}, pd[4] = {};
-    bool any_srgb = false;
-    for (int c = 0; c < C; ++c) any_srgb |= ((need >> c) & 1u) && srgb_codes[c];
-    if (kVbmi && any_srgb) {
+    if (kVbmi && needs_srgb) {
         const SrgbCodeBytes& table = srgb_code_bytes<Isa>();
         srgb_codes_vbmi<Isa>(wa, table, pa);
         srgb_codes_vbmi<Isa>(wb, table, pb);
