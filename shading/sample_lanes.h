@@ -3,8 +3,9 @@
 // into texel indices and filter weights (branch-free loops over lanes, which
 // the compiler vectorises), and fetch_trilinear_lanes() reads and blends the
 // texels. 8-bit textures are read 8 (or 4; 16 where the 16-lane loops run
-// their AVX-512 copy, shading/isa.h) lanes per instruction: an AVX2
-// gather of each tap's packed texel bytes, the channels unpacked into their
+// their AVX-512 copy, shading/isa.h) lanes per instruction: a gather of
+// each tap's packed texel bytes (8-byte reads as a load per lane, simd.h
+// says why), the channels unpacked into their
 // 15-bit codes (a shift, or a gather from the sRGB code table), then the
 // fixed-point lerps of texture.h, each one multiply-add of 16-bit pairs
 // (_mm256_madd_epi16); sparse blocks and builds without AVX2 call the scalar
@@ -305,27 +306,23 @@ inline void fetch_lanes_one_by_one(const Texture* const* tex, int count, const T
 
 #ifdef __AVX2__
 
-// The packed bytes of texel idx (C bytes each, 4 read) for W lanes.
+// The packed bytes of texel ix[l] (C bytes each, 4 read) for W lanes.
 template <class V, int C>
-inline typename V::I gather_texels(const std::uint8_t* base, typename V::I idx) {
-    if constexpr (C == 4) return V::template gather_i<4>(base, idx);
-    if constexpr (C == 2) return V::template gather_i<2>(base, idx);
-    if constexpr (C == 1) return V::template gather_i<1>(base, idx);
-    return V::template gather_i<1>(base, V::add_i(idx, V::add_i(idx, idx)));  // 3 idx
+inline typename V::I gather_texels(const std::uint8_t* base, const std::int32_t* ix) {
+    return V::template gather_i<C>(base, ix);
 }
 
 // The packed bytes of texels idx and idx + 1 (C bytes each) for W lanes: one
 // 4-byte read per lane holds both when C <= 2, one 8-byte read when C >= 3.
 // Texture keeps 8 spare bytes after the chain (Texture::kReadSlack).
 template <class V, int C>
-inline void gather_texel_pairs(const std::uint8_t* base, typename V::I idx, typename V::I& left, typename V::I& right) {
+inline void gather_texel_pairs(const std::uint8_t* base, const std::int32_t* ix, typename V::I& left,
+                               typename V::I& right) {
     if constexpr (C <= 2) {
-        left = V::template gather_i<C>(base, idx);
+        left = V::template gather_i<C>(base, ix);
         right = V::srlv_i(left, V::set1_i(8 * C));
-    } else if constexpr (C == 3) {
-        V::template gather_q<1, 24>(base, V::add_i(idx, V::add_i(idx, idx)), left, right);
     } else {
-        V::template gather_q<4, 32>(base, idx, left, right);
+        V::template gather_q<C, 8 * C>(base, ix, left, right);
     }
 }
 
@@ -393,18 +390,6 @@ template <class Isa>
     code[1] = _mm512_maskz_srli_epi32(0xFFFF, c01, 16);
     code[2] = _mm512_and_si512(c23, low16);
     code[3] = _mm512_maskz_srli_epi32(0xFFFF, c23, 16);
-}
-
-// A lane's two taps of one row (texels x0 and x1) as the qword read at x0,
-// 16 lanes in two registers of eight, for 3 or 4 bytes a texel.
-template <class Isa, int C>
-[[gnu::always_inline]] inline void pair_qwords(const std::uint8_t* base, __m512i idx, __m512i* q) {
-    const __m512i offset = C == 3 ? _mm512_add_epi32(idx, _mm512_add_epi32(idx, idx)) : idx;
-    constexpr int kScale = C == 3 ? 1 : 4;
-    q[0] = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_maskz_extracti64x4_epi64(0xF, offset, 0),
-                                       base, kScale);
-    q[1] = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_maskz_extracti64x4_epi64(0xF, offset, 1),
-                                       base, kScale);
 }
 
 // Byte indices for a permute of two registers (128 bytes) that puts a
@@ -510,8 +495,9 @@ template <class V, int C, class Isa>
     if constexpr (std::is_same_v<Isa, IsaAvx512Vbmi> && (C == 3 || C == 4)) {
         if (pairs) {
             I qa[2], qc[2], la[2] = {}, ha[2] = {}, lc[2] = {}, hc[2] = {};
-            pair_qwords<Isa, C>(base, ia, qa);
-            pair_qwords<Isa, C>(base, ic, qc);
+            // A lane's two taps of a row (x0 and x1) are the qword read at x0.
+            V::template gather_qwords<C>(base, idx[0] + l0, qa);
+            V::template gather_qwords<C>(base, idx[2] + l0, qc);
             if (needs_srgb) {
                 const SrgbCodeBytes& table = srgb_code_bytes<Isa>();
                 for (int k = 0; k < 2; ++k) {
@@ -539,7 +525,7 @@ template <class V, int C, class Isa>
         // (x0, x1) bytes move into the low bytes of the two words by one
         // byte shuffle, and times 128 they are lerp8's code pair.
         if (pairs && !needs_srgb) {
-            const I ra = V::template gather_i<C>(base, ia), rc = V::template gather_i<C>(base, ic);
+            const I ra = V::template gather_i<C>(base, idx[0] + l0), rc = V::template gather_i<C>(base, idx[2] + l0);
             for (int c = 0; c < C; ++c) {
                 if (!((need >> c) & 1u)) continue;
                 // Bytes c and C + c of the lane's dword to bytes 0 and 2; 0x80 zeroes 1 and 3.
@@ -553,13 +539,13 @@ template <class V, int C, class Isa>
     }
     I wa, wb, wc, wd;
     if (pairs) {
-        gather_texel_pairs<V, C>(base, ia, wa, wb);
-        gather_texel_pairs<V, C>(base, ic, wc, wd);
+        gather_texel_pairs<V, C>(base, idx[0] + l0, wa, wb);
+        gather_texel_pairs<V, C>(base, idx[2] + l0, wc, wd);
     } else {
-        wa = gather_texels<V, C>(base, ia);
-        wb = gather_texels<V, C>(base, ib);
-        wc = gather_texels<V, C>(base, ic);
-        wd = gather_texels<V, C>(base, id);
+        wa = gather_texels<V, C>(base, idx[0] + l0);
+        wb = gather_texels<V, C>(base, idx[1] + l0);
+        wc = gather_texels<V, C>(base, idx[2] + l0);
+        wd = gather_texels<V, C>(base, idx[3] + l0);
     }
 #if defined(__AVX512VBMI__)
     // Every sRGB channel's codes from the permutes (vbmi_serves()).

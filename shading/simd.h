@@ -7,13 +7,43 @@
 
 #ifdef __AVX2__
 
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <utility>
 
 #include <immintrin.h>
 
 #include "shading/isa.h"
 
 namespace prast {
+
+// Eight-byte gathers are written as one load per lane: on AMD's Zen 4 (the
+// machine docs/performance.md measures) a vpgatherdq is slower than the eight
+// loads and inserts it stands for (the 8-bit fetch of 3- and 4-byte texels,
+// 1.04-1.08x frames side by side), while the 4-byte vpgatherdd is not (16
+// loads and inserts measured slower). The loads read exactly the bytes the
+// gather would: the index sign-extended, times Scale, from base.
+namespace simd_detail {
+
+template <class T, int Scale>
+[[gnu::always_inline]] inline T load_element(const std::uint8_t* base, std::int32_t i) {
+    T v;
+    std::memcpy(&v, base + std::ptrdiff_t(i) * Scale, sizeof v);
+    return v;
+}
+
+typedef long long Qword4 __attribute__((vector_size(32)));
+typedef long long Qword8 __attribute__((vector_size(64)));
+
+// The vector of the 8-byte elements at base + Scale ix[L].
+template <class Vec, int Scale, std::size_t... L>
+[[gnu::always_inline]] inline Vec load_qwords(const std::uint8_t* base, const std::int32_t* ix,
+                                              std::index_sequence<L...>) {
+    return Vec{load_element<long long, Scale>(base, ix[L])...};
+}
+
+} // namespace simd_detail
 
 // W lanes per instruction: 8 (ymm) or 4 (xmm).
 template <int W> struct Simd;
@@ -28,18 +58,25 @@ template <> struct Simd<8> {
     static F set1_f(float v) { return _mm256_set1_ps(v); }
     static F zero_f() { return _mm256_setzero_ps(); }
     static I lane_bits() { return _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128); }
-    template <int Scale> static I gather_i(const std::uint8_t* base, I idx) {
-        return _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale);
+    // The 4 bytes at base + Scale idx per lane (Scale 3: a 3-byte texel's
+    // index), from stored indices or a vector of them.
+    template <int Scale> [[gnu::always_inline]] static I gather_i(const std::uint8_t* base, I idx) {
+        if constexpr (Scale == 3) idx = _mm256_add_epi32(idx, _mm256_add_epi32(idx, idx));
+        return _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale == 3 ? 1 : Scale);
+    }
+    template <int Scale> [[gnu::always_inline]] static I gather_i(const std::uint8_t* base, const std::int32_t* ix) {
+        return gather_i<Scale>(base, load_i(ix));
     }
     static F gather_f(const float* table, I idx) { return _mm256_i32gather_ps(table, idx, 4); }
-    // The 8 bytes at base + Scale idx for each lane: their low 4 bytes, and 4
-    // bytes from Shift bits on. The gathers take the lanes in the order
+    // The 8 bytes at base + Scale ix[l] for each lane: their low 4 bytes, and
+    // 4 bytes from Shift bits on. The qwords are read in the lane order
     // 0 1 4 5 and 2 3 6 7, so that one in-lane shuffle puts them back.
-    template <int Scale, int Shift> static void gather_q(const std::uint8_t* base, I idx, I& low, I& shifted) {
-        const I order = _mm256_permutevar8x32_epi32(idx, _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7));
-        const auto* q = reinterpret_cast<const long long*>(base);
-        const I a = _mm256_i32gather_epi64(q, _mm256_castsi256_si128(order), Scale);
-        const I b = _mm256_i32gather_epi64(q, _mm256_extracti128_si256(order, 1), Scale);
+    template <int Scale, int Shift>
+    [[gnu::always_inline]] static void gather_q(const std::uint8_t* base, const std::int32_t* ix, I& low, I& shifted) {
+        using simd_detail::Qword4;
+        const std::int32_t ia[4] = {ix[0], ix[1], ix[4], ix[5]}, ib[4] = {ix[2], ix[3], ix[6], ix[7]};
+        const I a = I(simd_detail::load_qwords<Qword4, Scale>(base, ia, std::make_index_sequence<4>()));
+        const I b = I(simd_detail::load_qwords<Qword4, Scale>(base, ib, std::make_index_sequence<4>()));
         low = pick_low(a, b);
         shifted = pick_low(_mm256_srli_epi64(a, Shift), _mm256_srli_epi64(b, Shift));
     }
@@ -89,13 +126,19 @@ template <> struct Simd<4> {
     static F set1_f(float v) { return _mm_set1_ps(v); }
     static F zero_f() { return _mm_setzero_ps(); }
     static I lane_bits() { return _mm_setr_epi32(1, 2, 4, 8); }
-    template <int Scale> static I gather_i(const std::uint8_t* base, I idx) {
-        return _mm_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale);
+    template <int Scale> [[gnu::always_inline]] static I gather_i(const std::uint8_t* base, I idx) {
+        if constexpr (Scale == 3) idx = _mm_add_epi32(idx, _mm_add_epi32(idx, idx));
+        return _mm_i32gather_epi32(reinterpret_cast<const int*>(base), idx, Scale == 3 ? 1 : Scale);
+    }
+    template <int Scale> [[gnu::always_inline]] static I gather_i(const std::uint8_t* base, const std::int32_t* ix) {
+        return gather_i<Scale>(base, load_i(ix));
     }
     static F gather_f(const float* table, I idx) { return _mm_i32gather_ps(table, idx, 4); }
     // As Simd<8>::gather_q, for 4 lanes.
-    template <int Scale, int Shift> static void gather_q(const std::uint8_t* base, I idx, I& low, I& shifted) {
-        const __m256i q = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(base), idx, Scale);
+    template <int Scale, int Shift>
+    [[gnu::always_inline]] static void gather_q(const std::uint8_t* base, const std::int32_t* ix, I& low, I& shifted) {
+        const __m256i q =
+            __m256i(simd_detail::load_qwords<simd_detail::Qword4, Scale>(base, ix, std::make_index_sequence<4>()));
         low = pick_low(q);
         shifted = pick_low(_mm256_srli_epi64(q, Shift));
     }
@@ -156,18 +199,29 @@ template <> struct Simd<16> {
     static I lane_bits() {
         return _mm512_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384, 32768);
     }
-    template <int Scale> static I gather_i(const std::uint8_t* base, I idx) {
-        return _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), 0xFFFF, idx, base, Scale);
+    template <int Scale> [[gnu::always_inline]] static I gather_i(const std::uint8_t* base, I idx) {
+        if constexpr (Scale == 3) idx = _mm512_add_epi32(idx, _mm512_add_epi32(idx, idx));
+        return _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), 0xFFFF, idx, base, Scale == 3 ? 1 : Scale);
+    }
+    template <int Scale> [[gnu::always_inline]] static I gather_i(const std::uint8_t* base, const std::int32_t* ix) {
+        return gather_i<Scale>(base, load_i(ix));
     }
     static F gather_f(const float* table, I idx) {
         return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), 0xFFFF, idx, table, 4);
     }
-    // As Simd<8>::gather_q: eight qwords per gather, in lane order.
-    template <int Scale, int Shift> static void gather_q(const std::uint8_t* base, I idx, I& low, I& shifted) {
-        const I a = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_maskz_extracti64x4_epi64(0xF, idx, 0),
-                                                base, Scale);
-        const I b = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), 0xFF, _mm512_maskz_extracti64x4_epi64(0xF, idx, 1),
-                                                base, Scale);
+    // The 8 bytes at base + Scale ix[l], lanes 0-7 in q[0] and 8-15 in q[1].
+    template <int Scale>
+    [[gnu::always_inline]] static void gather_qwords(const std::uint8_t* base, const std::int32_t* ix, I* q) {
+        using simd_detail::Qword8;
+        q[0] = I(simd_detail::load_qwords<Qword8, Scale>(base, ix, std::make_index_sequence<8>()));
+        q[1] = I(simd_detail::load_qwords<Qword8, Scale>(base, ix + 8, std::make_index_sequence<8>()));
+    }
+    // As Simd<8>::gather_q, the qwords in lane order.
+    template <int Scale, int Shift>
+    [[gnu::always_inline]] static void gather_q(const std::uint8_t* base, const std::int32_t* ix, I& low, I& shifted) {
+        I q[2];
+        gather_qwords<Scale>(base, ix, q);
+        const I a = q[0], b = q[1];
         low = join(low_dwords(a), low_dwords(b));
         shifted = join(low_dwords(_mm512_maskz_srli_epi64(0xFF, a, Shift)), low_dwords(_mm512_maskz_srli_epi64(0xFF, b, Shift)));
     }

@@ -460,7 +460,7 @@ void check_texel_pairs(std::mt19937& rng) {
         alignas(32) std::int32_t idx[W];
         for (int l = 0; l < W; ++l) idx[l] = iter % 4 == 0 && l == iter % W ? texels - 1 : any(rng);
         typename V::I left, right;
-        sample_lanes_detail::gather_texel_pairs<V, C>(base, V::load_i(idx), left, right);
+        sample_lanes_detail::gather_texel_pairs<V, C>(base, idx, left, right);
         alignas(32) std::uint32_t got_left[W], got_right[W];
         std::memcpy(got_left, &left, sizeof got_left);
         std::memcpy(got_right, &right, sizeof got_right);
