@@ -87,21 +87,28 @@ inline void set_more_derivatives(SurfaceLanes& s, const FragmentBlock<NV>& in, i
 }
 
 // The lanes of mask m in order, as bytes, into out[0, 16) (zero past them).
-inline void list_lanes(std::uint32_t m, std::uint8_t* out) {
-#if defined(__BMI2__)
+#if defined(__AVX2__) && defined(__BMI2__)
+using LaneList = __m128i;
+// Also returned in a register: read back from memory at once, two 8-byte
+// stores would stall the 16-byte load (no store forwarding across them).
+inline __m128i list_lanes(std::uint32_t m, std::uint8_t* out) {
     // Nibble l of `live` is 0xF for a live lane l; pext gathers those lanes'
     // numbers from the nibble sequence 0..15, and pdep spreads them to bytes.
     const std::uint64_t live = _pdep_u64(m, 0x1111111111111111ull) * 0xF;
     const std::uint64_t lanes = _pext_u64(0xFEDCBA9876543210ull, live);
     const std::uint64_t lo = _pdep_u64(lanes, 0x0F0F0F0F0F0F0F0Full);
     const std::uint64_t hi = _pdep_u64(lanes >> 32, 0x0F0F0F0F0F0F0F0Full);
-    std::memcpy(out, &lo, 8);
-    std::memcpy(out + 8, &hi, 8);
+    const __m128i v = _mm_set_epi64x(std::int64_t(hi), std::int64_t(lo));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out), v);
+    return v;
+}
 #else
+struct LaneList {};
+inline void list_lanes(std::uint32_t m, std::uint8_t* out) {
     std::memset(out, 0, 16);
     for (int n = 0; m; m &= m - 1) out[n++] = std::uint8_t(__builtin_ctz(m));
-#endif
 }
+#endif
 
 #if defined(__AVX2__) && defined(__BMI2__)
 // 0xFF in byte l (of eight) for each set bit l of m.
@@ -131,17 +138,20 @@ inline __m256 take_packed(const float* src, __m256i pos) {
 // repeat the last live one. Rows hold N + 8 floats: with AVX2 each block's
 // lanes are stored eight at a time, spilling into the next block's (written
 // after) or the spare lanes (written last).
+// With AVX2 and BMI2 the lanes come as each block's list_lanes() register
+// (block_lanes), not read back from `lane`.
 template <int N, int NV>
 void pack_lanes(const FragmentBlock<NV>* const* in, int count, const std::uint8_t* first,
-                const std::uint8_t* lane, float (*packed)[N + 8]) {
+                [[maybe_unused]] const std::uint8_t* lane, [[maybe_unused]] const LaneList* block_lanes,
+                float (*packed)[N + 8]) {
     const int n = first[count];
-#if defined(__AVX2__)
+#if defined(__AVX2__) && defined(__BMI2__)
     for (int b = 0; b < count; ++b) {
-        for (int j = first[b]; j < first[b + 1]; j += 8) {
+        __m128i lanes = block_lanes[b];
+        for (int j = first[b]; j < first[b + 1]; j += 8, lanes = _mm_srli_si128(lanes, 8)) {
             // Both halves of each varying permuted, then blended. Past the
-            // block's lanes the bytes are another block's or zero: any lane
-            // will do there.
-            const __m256i idx = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(lane + j)));
+            // block's lanes the bytes are zero: any lane will do there.
+            const __m256i idx = _mm256_cvtepu8_epi32(lanes);
             const __m256 from_high = _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7)));
             for (int k = 0; k < NV; ++k) {
                 const __m256 lo = _mm256_permutevar8x32_ps(_mm256_load_ps(in[b]->var[k]), idx);
@@ -157,15 +167,11 @@ void pack_lanes(const FragmentBlock<NV>* const* in, int count, const std::uint8_
 #endif
     if (n == N) return;
 #if defined(__AVX2__)
-    // Lanes n.. take lane n - 1's value, eight at a time.
-    const __m256i spare_from = _mm256_set1_epi32(n - 1);
-    for (int h = (n / 8) * 8; h < N; h += 8) {
-        const __m256 spare = _mm256_castsi256_ps(
-            _mm256_cmpgt_epi32(_mm256_add_epi32(_mm256_set1_epi32(h), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)), spare_from));
-        for (int k = 0; k < NV; ++k) {
-            const __m256 last = _mm256_broadcast_ss(&packed[k][n - 1]);
-            _mm256_storeu_ps(packed[k] + h, _mm256_blendv_ps(_mm256_loadu_ps(packed[k] + h), last, spare));
-        }
+    // Lanes n.. take lane n - 1's value, eight at a time (stored over, not
+    // blended: reading back what the overlapping stores above wrote stalls).
+    for (int k = 0; k < NV; ++k) {
+        const __m256 last = _mm256_broadcast_ss(&packed[k][n - 1]);
+        for (int h = n; h < N; h += 8) _mm256_storeu_ps(packed[k] + h, last);
     }
 #else
     for (int k = 0; k < NV; ++k)
@@ -216,29 +222,29 @@ void PbrProgramT<NV>::shade_packed(const FragmentBlock<kVaryings>* const* in, Fr
     // lane[i], quad[i]: packed lane i's block lane and quad slot; each block
     // writes 16 bytes from its first lane on, the next block overwriting the excess.
     std::uint8_t lane[kBlockLanes + 16], quad[kBlockLanes + 16], first[kMaxBatchBlocks + 1];
+    LaneList block_lanes[kMaxBatchBlocks];  // [0, count) set below
     int n = 0, slots = 0;
     for (int b = 0; b < count; ++b) {
         const FragmentBlock<kVaryings>& B = *in[b];
-        alignas(16) std::uint8_t slot_of[16] = {};
+        std::uint32_t slot_of = 0;  // byte q: quad q's slot
         for (int q = 0; q < 4; ++q) {
             if (!B.quad_live(q)) continue;
-            slot_of[q] = std::uint8_t(slots);
+            slot_of |= std::uint32_t(slots) << (8 * q);
             s.dudx[slots] = B.ddx(kVarUV, 4 * q); s.dvdx[slots] = B.ddx(kVarUV + 1, 4 * q);
             s.dudy[slots] = B.ddy(kVarUV, 4 * q); s.dvdy[slots] = B.ddy(kVarUV + 1, 4 * q);
             set_more_derivatives<NV>(s, B, 4 * q, slots);
             ++slots;
         }
         first[b] = std::uint8_t(n);
-        list_lanes(B.mask, lane + n);
         const int nb = __builtin_popcount(B.mask);
-#if defined(__AVX2__)
+#if defined(__AVX2__) && defined(__BMI2__)
         // quad[i] = slot_of[lane[i] / 4], sixteen at a time.
-        const __m128i q = _mm_and_si128(_mm_srli_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(lane + n)), 2),
-                                        _mm_set1_epi8(3));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(quad + n),
-                         _mm_shuffle_epi8(_mm_load_si128(reinterpret_cast<const __m128i*>(slot_of)), q));
+        block_lanes[b] = list_lanes(B.mask, lane + n);
+        const __m128i q = _mm_and_si128(_mm_srli_epi16(block_lanes[b], 2), _mm_set1_epi8(3));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(quad + n), _mm_shuffle_epi8(_mm_cvtsi32_si128(int(slot_of)), q));
 #else
-        for (int i = n; i < n + nb; ++i) quad[i] = slot_of[lane[i] >> 2];
+        list_lanes(B.mask, lane + n);
+        for (int i = n; i < n + nb; ++i) quad[i] = std::uint8_t(slot_of >> (8 * (lane[i] >> 2)));
 #endif
         if (!B.front_facing) s.back_facing |= ((1u << nb) - 1u) << n;
         n += nb;
@@ -250,7 +256,7 @@ void PbrProgramT<NV>::shade_packed(const FragmentBlock<kVaryings>* const* in, Fr
 
     alignas(64) float packed[kVaryings][N + 8];
     const float* var[kVaryings];
-    pack_lanes<N, NV>(in, count, first, lane, packed);
+    pack_lanes<N, NV>(in, count, first, lane, block_lanes, packed);
     for (int k = 0; k < kVaryings; ++k) var[k] = packed[k];
     set_surface<NV>(s, var, has_color());
     s.quad = quad;
