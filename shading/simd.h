@@ -18,12 +18,11 @@
 
 namespace prast {
 
-// Eight-byte gathers are written as one load per lane: on AMD's Zen 4 (the
-// machine docs/performance.md measures) a vpgatherdq is slower than the eight
-// loads and inserts it stands for (the 8-bit fetch of 3- and 4-byte texels,
-// 1.04-1.08x frames side by side), while the 4-byte vpgatherdd is not (16
-// loads and inserts measured slower). The loads read exactly the bytes the
-// gather would: the index sign-extended, times Scale, from base.
+// Eight-byte gathers are written as one load per lane: on AMD's Zen 4 a
+// vpgatherdq is slower than the eight loads and inserts it stands for, while
+// the 4-byte vpgatherdd is not (docs/performance.md, "Eight-byte gathers
+// are loads"). The loads read exactly the bytes the gather would: the index
+// sign-extended, times Scale, from base.
 namespace simd_detail {
 
 template <class T, int Scale>
