@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <mutex>
 #include <new>
 
@@ -349,6 +350,10 @@ void SceneRenderer::begin_pass(const FrameSettings& s, Framebuffer& fb, const Im
     pass.background->attach(frame);
     renderer_.begin(fb, frame);
     pass.view_proj = s.camera.view_projection(float(fb.width) / float(fb.height));
+    // The texture lookups of every bound material, planned once per frame
+    // rather than per block.
+    pass.plans.resize(bound_.size());
+    for (std::size_t i = 0; i < bound_.size(); ++i) plan_lookups(bound_[i], pass.plans[i]);
     // Opaque and MASK meshes in file order, then BLEND ones back to front.
     pass.order = draw_order(scene_, s.camera.eye);
 }
@@ -363,6 +368,9 @@ P SceneRenderer::program_of(const FrameSettings& s, const Pass& pass, const Mesh
     prog.view = s.view;
     prog.near_plane = s.camera.near_plane;
     prog.far_plane = s.camera.far_plane;
+    const std::less<const BoundMaterial*> before;  // a total order, also for the fallback's address
+    if (!before(&bm, bound_.data()) && before(&bm, bound_.data() + bound_.size()) && pass.plans.size() == bound_.size())
+        prog.plan = &pass.plans[std::size_t(&bm - bound_.data())];
     return prog;
 }
 

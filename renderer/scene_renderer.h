@@ -192,6 +192,7 @@ private:
         bool overlay = false;
         std::vector<std::size_t> order;
         std::optional<BackgroundFill> background;  // the frame's clear reads it until end()
+        std::vector<LookupPlan> plans;  // of bound_[i], for the lane sampler
     };
     void begin_pass(const FrameSettings& settings, Framebuffer& fb, const ImageOutput* out, Pass& pass);
     PbrProgram program(const FrameSettings& settings, const Pass& pass, const Mesh& mesh,

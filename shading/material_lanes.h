@@ -68,69 +68,70 @@ inline void copy_lanes(float* dst, const float* src) { std::memcpy(dst, src, siz
 
 } // namespace material_lanes_detail
 
+// plan_lookups(bm, plan) (declared in surface.h, defined in
+// material_lanes.cpp as default code, which the AVX-512 copy calls too):
+// every map the lanes read, with the components that are used (bit 0 r ..
+// 3 a), keyed by UV set and texture transform (key = set * 8 + 1 + the
+// first map with an equal transform, or set * 8 without one; all 0 unless
+// a map reads another set or has a transform), grouped by layout and key
+// in order of first appearance.
+
+namespace material_lanes_detail {
+// The maps the lanes read, in BoundMaterial's order: the base colour alone
+// for KHR_materials_unlit.
+[[gnu::always_inline]] inline void lane_maps(const BoundMaterial& bm, const Texture** maps) {
+    const bool unlit = bm.m->unlit;
+    const Texture* const all[BoundMaterial::kMaps] = {bm.base_color, bm.metallic_roughness, bm.roughness, bm.metallic,
+                                                      bm.normal,     bm.occlusion,          bm.emissive};
+    for (int i = 0; i < BoundMaterial::kMaps; ++i) maps[i] = unlit && i != BoundMaterial::kBaseColor ? nullptr : all[i];
+}
+} // namespace material_lanes_detail
+
 // Fills the first N lanes of mb for the lanes in `live` (the others get
 // values nobody reads) and returns the live lanes an alpha MASK discards.
+// `plan`: bm's plan_lookups(), or null (or another binding's) to plan here.
 #if PRAST_CALLS_AVX512
 // sample_material_lanes<16, IsaAvx512>, compiled for AVX-512 alone
 // (shading/sample_lanes_avx512.cpp) and called only when the CPU has it.
 std::uint32_t sample_material_lanes16_avx512(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
-                                             MaterialBlock& mb);
+                                             MaterialBlock& mb, const LookupPlan* plan);
 #endif
 
 template <int N = kBlockLanes, class Isa = IsaDefault>
 inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
-                                           MaterialBlock& mb) {
+                                           MaterialBlock& mb, const LookupPlan* plan = nullptr) {
     using namespace material_lanes_detail;
     static_assert(N % 4 == 0 && N <= kBlockLanes, "whole vectors of lanes");
 #if PRAST_CALLS_AVX512
     if constexpr (N == 16 && std::is_same_v<Isa, IsaDefault>) {
-        if (use_avx512()) return sample_material_lanes16_avx512(bm, s, live, mb);
+        if (use_avx512()) return sample_material_lanes16_avx512(bm, s, live, mb, plan);
     }
 #endif
     const Material& m = *bm.m;
 
-    // Look up every bound texture, the components that are used only (bit 0
-    // r .. 3 a). Textures of one layout share their level of detail and texel
-    // indices (sample_lanes.h), prepared and read together; a texture bound
-    // twice (glTF occlusion in R of the metal-roughness map) is read once.
+    // Look up every bound texture, the components that are used only, as
+    // plan_lookups() says: textures of one layout share their level of
+    // detail and texel indices (sample_lanes.h), prepared and read
+    // together; a texture bound twice (glTF occlusion in R of the
+    // metal-roughness map) is read once.
     enum { kBase, kMetalRough, kRough, kMetal, kNormal, kOcclusion, kEmissive, kMaps };
     static_assert(int(kMaps) == int(BoundMaterial::kMaps) && int(kEmissive) == int(BoundMaterial::kEmissive),
                   "the maps in BoundMaterial's order");
     const bool unlit = m.unlit;  // KHR_materials_unlit: the base colour alone is read
-    const Texture* maps[kMaps] = {bm.base_color, unlit ? nullptr : bm.metallic_roughness,
-                                  unlit ? nullptr : bm.roughness, unlit ? nullptr : bm.metallic,
-                                  unlit ? nullptr : bm.normal, unlit ? nullptr : bm.occlusion,
-                                  unlit ? nullptr : bm.emissive};
+    const Texture* maps[kMaps];
+    lane_maps(bm, maps);
     const bool mask_mode = m.alpha_mode == AlphaMode::Mask;
     const bool alpha_read = mask_mode || m.alpha_mode == AlphaMode::Blend;
-    const std::uint8_t used[kMaps] = {std::uint8_t(alpha_read ? 0xF : 0x7), 0x6, 0x1, 0x1, 0x7, 0x1, 0x7};
-    // UV sets: all 0 unless a map reads another (one test on the usual path).
-    std::uint64_t uv_word = 0;
-    static_assert(sizeof(bm.uv) <= sizeof(uv_word), "the UV sets fit one word");
-    std::memcpy(&uv_word, &bm.uv, sizeof(bm.uv));
-    // Maps are keyed by UV set and texture transform: key = set * 8 + 1 +
-    // the first map with an equal transform, or set * 8 without one. All 0
-    // unless a map reads another set or has a transform.
-    const std::uint8_t transformed = bm.transformed;
-    const bool multi_uv = uv_word != 0 || transformed != 0;
-    std::uint8_t set[kMaps] = {}, key[kMaps] = {};
-    if (multi_uv) {
-        set[kBase] = bm.uv.base_color; set[kMetalRough] = bm.uv.metallic_roughness; set[kRough] = bm.uv.roughness;
-        set[kMetal] = bm.uv.metallic; set[kNormal] = bm.uv.normal; set[kOcclusion] = bm.uv.occlusion;
-        set[kEmissive] = bm.uv.emissive;
-        for (int i = 0; i < kMaps; ++i) {
-            key[i] = std::uint8_t(set[i] * 8);
-            if (!((transformed >> i) & 1u)) continue;
-            int j = 0;
-            while (!((transformed >> j) & 1u) || !(bm.xf[j] == bm.xf[i])) ++j;
-            key[i] = std::uint8_t(key[i] + 1 + j);
-        }
-    }
     TexelLanes texel[kMaps];
     const TexelLanes* tl[kMaps];
-    for (int i = 0; i < kMaps; ++i) tl[i] = &texel[i];
     if (maps[kBase] || maps[kMetalRough] || maps[kRough] || maps[kMetal] || maps[kNormal] || maps[kOcclusion] ||
         maps[kEmissive]) {
+        LookupPlan local;
+        if (!plan || plan->bm != &bm) {
+            plan_lookups(bm, local);
+            plan = &local;
+        }
+        for (int i = 0; i < kMaps; ++i) tl[i] = &texel[plan->slot[i]];
         std::uint32_t live_quads = 0;
         if (!s.quad) {
             for (int q = 0; q < 4; ++q) live_quads |= std::uint32_t(((live >> (4 * q)) & 0xFu) != 0) << q;
@@ -138,36 +139,14 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
             for (int l = 0; l < N; ++l)
                 if ((live >> l) & 1u) live_quads |= 1u << s.quad[l];
         }
-        // Group the maps by layout and UV set, in order of first appearance.
-        int groups = 0;
-        const Texture* group_tex[kMaps][kMaps];
+        const int groups = plan->groups;
+        const auto& group_tex = plan->tex;
+        const auto& group_used = plan->used;
+        const auto& group_key = plan->key;
+        const auto& group_size = plan->size;
         TexelLanes* group_out[kMaps][kMaps];
-        std::uint8_t group_used[kMaps][kMaps];
-        std::uint8_t group_key[kMaps];
-        int group_size[kMaps];
-        for (int i = 0; i < kMaps; ++i) {
-            if (!maps[i]) continue;
-            int j = 0;
-            while (j < i && (maps[j] != maps[i] || (multi_uv && key[j] != key[i]))) ++j;
-            if (j < i) {  // the same texture at the same uv again: share its lookup
-                tl[i] = tl[j];
-                for (int g = 0; g < groups; ++g)
-                    for (int k = 0; k < group_size[g]; ++k)
-                        if (group_tex[g][k] == maps[i] && (!multi_uv || group_key[g] == key[i]))
-                            group_used[g][k] |= used[i];
-                continue;
-            }
-            int g = 0;
-            while (g < groups && !((!multi_uv || group_key[g] == key[i]) && same_sampling_layout(*group_tex[g][0], *maps[i])))
-                ++g;
-            if (g == groups) {
-                group_key[groups] = key[i];
-                group_size[groups++] = 0;
-            }
-            group_tex[g][group_size[g]] = maps[i];
-            group_used[g][group_size[g]] = used[i];
-            group_out[g][group_size[g]++] = &texel[i];
-        }
+        for (int g = 0; g < groups; ++g)
+            for (int k = 0; k < group_size[g]; ++k) group_out[g][k] = &texel[plan->out[g][k]];
         for (int g = 0; g < groups; ++g) {
             // material_lods(): one lambda per quad with a live lane.
             const Texture& first = *group_tex[g][0];

@@ -199,7 +199,7 @@ void PbrProgramT<NV>::shade_block(const FragmentBlock<kVaryings>& in, FragmentOu
     s.back_facing = in.front_facing ? 0u : 0xFFFFu;
 
     MaterialBlock mb;
-    out.kill = sample_material_lanes<kBlockLanes>(*material, s, in.mask, mb);
+    out.kill = sample_material_lanes<kBlockLanes>(*material, s, in.mask, mb, plan);
     RadianceBlock rb;
     shade_block_lanes<kBlockLanes>(mb, *ctx, rb);
     const bool blend = material->m->alpha_mode == AlphaMode::Blend;
@@ -262,7 +262,7 @@ void PbrProgramT<NV>::shade_packed(const FragmentBlock<kVaryings>* const* in, Fr
     s.quad = quad;
 
     MaterialBlock mb;
-    const std::uint32_t kill = sample_material_lanes<N>(*material, s, live, mb);
+    const std::uint32_t kill = sample_material_lanes<N>(*material, s, live, mb, plan);
     RadianceBlock rb;
     shade_block_lanes<N>(mb, *ctx, rb);
 

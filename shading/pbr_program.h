@@ -44,6 +44,9 @@ struct PbrProgramT {
     const ShadingContext* ctx = nullptr;
     DebugView view = DebugView::None;
     float near_plane = 0.1f, far_plane = 100.0f;  // for the depth view
+    // The lane sampler's plan of `material`'s lookups (surface.h), made once
+    // per frame; without it (or with another binding's) blocks plan their own.
+    const LookupPlan* plan = nullptr;
 
     void vertex(std::uint32_t i, float clip[4], float* var) const {
         const glm::vec3& p = mesh->positions[i];

@@ -34,8 +34,8 @@ void prepare_trilinear_lanes16_avx512(const Texture& tex, const float* u, const 
 namespace prast {
 
 std::uint32_t sample_material_lanes16_avx512(const BoundMaterial& bm, const SurfaceLanes& s, std::uint32_t live,
-                                             MaterialBlock& mb) {
-    return sample_material_lanes<16, IsaAvx512>(bm, s, live, mb);
+                                             MaterialBlock& mb, const LookupPlan* plan) {
+    return sample_material_lanes<16, IsaAvx512>(bm, s, live, mb, plan);
 }
 
 void shade_block_lanes16_avx512(const MaterialBlock& m, const ShadingContext& ctx, RadianceBlock& out) {

@@ -97,6 +97,28 @@ struct BoundMaterial {
     }
 };
 
+// How the lane sampler reads a binding's maps (material_lanes.h,
+// plan_lookups()): the maps grouped by layout and UV key, each group
+// sharing its texel indices, and a map bound twice at one UV key reading the
+// first one's lanes. It depends on the binding alone (and its material's
+// alpha mode and unlit flag), so a frame plans each bound material once
+// (SceneRenderer's pass) instead of every block; `bm` names the binding it
+// was made for.
+struct LookupPlan {
+    static constexpr int kMaps = BoundMaterial::kMaps;
+    const BoundMaterial* bm = nullptr;
+    int groups = 0;
+    // Set by plan_lookups() as far as `groups` and `size` say (left
+    // uninitialised otherwise: a block's local plan is not zeroed first).
+    const Texture* tex[kMaps][kMaps];
+    std::uint8_t out[kMaps][kMaps];   // the map whose lanes each lookup fills
+    std::uint8_t used[kMaps][kMaps];  // its components (bit 0 r .. 3 a)
+    std::uint8_t key[kMaps];          // the group's UV set * 8 + its transform's key
+    int size[kMaps];
+    std::uint8_t slot[kMaps];         // the map whose lanes map i reads
+};
+void plan_lookups(const BoundMaterial& bm, LookupPlan& p);  // shading/material_lanes.cpp
+
 // Interpolated geometry at a pixel, world space.
 struct SurfacePoint {
     glm::vec3 P{0.0f};

@@ -256,8 +256,15 @@ void check_material(std::uint32_t seed, bool extended = false) {
         s.Cr = packed[14]; s.Cg = packed[15]; s.Cb = packed[16]; s.Ca = packed[17];
     }
 
+    // Planned by the call itself, in advance (as a draw does), or with a
+    // plan of another binding (ignored): the same lanes.
     MaterialBlock mb;
-    const std::uint32_t kill = sample_material_lanes<N>(bm, s, pk.live, mb);
+    LookupPlan plan, other;
+    plan_lookups(bm, plan);
+    const BoundMaterial bare{&m};
+    plan_lookups(bare, other);
+    const int way = int(seed % 3);
+    const std::uint32_t kill = sample_material_lanes<N>(bm, s, pk.live, mb, way == 0 ? nullptr : way == 1 ? &plan : &other);
     for (int l = 0; l < N; ++l) {
         if (!((pk.live >> l) & 1u)) continue;
         const int bl = pk.lane[l], q = bl & ~3;
