@@ -306,12 +306,6 @@ inline void fetch_lanes_one_by_one(const Texture* const* tex, int count, const T
 
 #ifdef __AVX2__
 
-// The packed bytes of texel ix[l] (C bytes each, 4 read) for W lanes.
-template <class V, int C>
-inline typename V::I gather_texels(const std::uint8_t* base, const std::int32_t* ix) {
-    return V::template gather_i<C>(base, ix);
-}
-
 // The packed bytes of texels idx and idx + 1 (C bytes each) for W lanes: one
 // 4-byte read per lane holds both when C <= 2, one 8-byte read when C >= 3.
 // Texture keeps 8 spare bytes after the chain (Texture::kReadSlack).
@@ -466,11 +460,21 @@ template <class V> inline typename V::I weight8(typename V::F t) {
 template <class V> inline typename V::I weight_pairs(typename V::I w) {
     return V::or_i(V::sub_i(V::set1_i(256), w), V::template slli_i<16>(w));
 }
+// a | b << 16: the 16-bit pair a lerp multiplies.
+template <class V> inline typename V::I code_pair(typename V::I a, typename V::I b) {
+    return V::or_i(a, V::template slli_i<16>(b));
+}
 template <class V> inline typename V::I lerp8(typename V::I a, typename V::I b, typename V::I pairs) {
-    return V::madd_i(V::or_i(a, V::template slli_i<16>(b)), pairs);
+    return V::madd_i(code_pair<V>(a, b), pairs);
 }
 template <class V> inline typename V::I narrow8(typename V::I x) {
     return V::template srli_i<8>(V::add_i(x, V::set1_i(128)));
+}
+// The bilinear filter of a row pair's codes, each row as (x0) | (x1) << 16:
+// the x-lerps narrowed, then the y-lerp (Texture::fix_bilinear()).
+template <class V>
+inline typename V::I bilerp_pairs(typename V::I top, typename V::I bottom, typename V::I wx, typename V::I wy) {
+    return lerp8<V>(narrow8<V>(V::madd_i(top, wx)), narrow8<V>(V::madd_i(bottom, wx)), wy);
 }
 
 // Bilinear filter of every needed stored channel of one level for lanes
@@ -510,7 +514,7 @@ template <class V, int C, class Isa>
                 if (!((need >> c) & 1u)) return;
                 I top, bottom;
                 pair_rows_vbmi<Isa, C, c>(qa, qc, la, ha, lc, hc, srgb_codes[c] != nullptr, top, bottom);
-                result[c] = lerp8<V>(narrow8<V>(V::madd_i(top, wx)), narrow8<V>(V::madd_i(bottom, wx)), wy);
+                result[c] = bilerp_pairs<V>(top, bottom, wx, wy);
             };
             channel(std::integral_constant<int, 0>());
             channel(std::integral_constant<int, 1>());
@@ -532,7 +536,7 @@ template <class V, int C, class Isa>
                 const I pick = V::add_i(V::set1_i(int(0x80008000u) | c | ((C + c) << 16)), V::dword_byte_offsets());
                 const I top = V::template slli_i<7>(V::shuffle_bytes(ra, pick));
                 const I bottom = V::template slli_i<7>(V::shuffle_bytes(rc, pick));
-                result[c] = lerp8<V>(narrow8<V>(V::madd_i(top, wx)), narrow8<V>(V::madd_i(bottom, wx)), wy);
+                result[c] = bilerp_pairs<V>(top, bottom, wx, wy);
             }
             return;
         }
@@ -542,10 +546,11 @@ template <class V, int C, class Isa>
         gather_texel_pairs<V, C>(base, idx[0] + l0, wa, wb);
         gather_texel_pairs<V, C>(base, idx[2] + l0, wc, wd);
     } else {
-        wa = gather_texels<V, C>(base, idx[0] + l0);
-        wb = gather_texels<V, C>(base, idx[1] + l0);
-        wc = gather_texels<V, C>(base, idx[2] + l0);
-        wd = gather_texels<V, C>(base, idx[3] + l0);
+        // Each tap's C bytes (4 read).
+        wa = V::template gather_i<C>(base, idx[0] + l0);
+        wb = V::template gather_i<C>(base, idx[1] + l0);
+        wc = V::template gather_i<C>(base, idx[2] + l0);
+        wd = V::template gather_i<C>(base, idx[3] + l0);
     }
 #if defined(__AVX512VBMI__)
     // Every sRGB channel's codes from the permutes (vbmi_serves()).
@@ -572,9 +577,7 @@ template <class V, int C, class Isa>
             a = channel_codes<V>(wa, c, codes); b = channel_codes<V>(wb, c, codes);
             cc = channel_codes<V>(wc, c, codes); d = channel_codes<V>(wd, c, codes);
         }
-        const I top = narrow8<V>(lerp8<V>(a, b, wx));
-        const I bottom = narrow8<V>(lerp8<V>(cc, d, wx));
-        result[c] = lerp8<V>(top, bottom, wy);
+        result[c] = bilerp_pairs<V>(code_pair<V>(a, b), code_pair<V>(cc, d), wx, wy);
     }
 }
 

@@ -220,9 +220,9 @@ template <> struct Simd<16> {
     [[gnu::always_inline]] static void gather_q(const std::uint8_t* base, const std::int32_t* ix, I& low, I& shifted) {
         I q[2];
         gather_qwords<Scale>(base, ix, q);
-        const I a = q[0], b = q[1];
-        low = join(low_dwords(a), low_dwords(b));
-        shifted = join(low_dwords(_mm512_maskz_srli_epi64(0xFF, a, Shift)), low_dwords(_mm512_maskz_srli_epi64(0xFF, b, Shift)));
+        low = join(low_dwords(q[0]), low_dwords(q[1]));
+        shifted = join(low_dwords(_mm512_maskz_srli_epi64(0xFF, q[0], Shift)),
+                       low_dwords(_mm512_maskz_srli_epi64(0xFF, q[1], Shift)));
     }
     static I add_i(I a, I b) { return _mm512_add_epi32(a, b); }
     static I sub_i(I a, I b) { return _mm512_sub_epi32(a, b); }
