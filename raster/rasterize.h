@@ -107,16 +107,28 @@ inline void lane_offsets(std::int64_t a, std::int64_t b, std::int64_t* out) {
     std::memcpy(out + 12, &quad3, sizeof quad3);
 }
 
+// What the sample tests need: lane and sample offsets.
 template <bool MS>
-inline void prepare_coverage(const TriangleSetup& t, const TileContext& c, TriangleInTile& p) {
+inline void prepare_lanes(const TriangleSetup& t, const TileContext& c, TriangleInTile& p) {
     for (int e = 0; e < 3; ++e) {
         lane_offsets(t.A[e], t.B[e], p.lane_offset[e]);
         if constexpr (MS) {
             const SamplePattern& sp = *c.samples;
-            p.coarse[e] = edge_span(t, e, kCoarseBlockSize, c.extent);
-            p.fine[e] = edge_span(t, e, kBlockSize, c.extent);
             for (int s = 0; s < sp.count; ++s)
                 p.sample_offset[e][s] = std::int64_t(t.A[e]) * sp.fixed_x(s) + std::int64_t(t.B[e]) * sp.fixed_y(s);
+        } else {
+            p.sample_offset[e][0] = 0;
+        }
+    }
+}
+
+// What the block classification needs besides: the edges' spans.
+template <bool MS>
+inline void prepare_spans(const TriangleSetup& t, const TileContext& c, TriangleInTile& p) {
+    for (int e = 0; e < 3; ++e) {
+        if constexpr (MS) {
+            p.coarse[e] = edge_span(t, e, kCoarseBlockSize, c.extent);
+            p.fine[e] = edge_span(t, e, kBlockSize, c.extent);
         } else {
             // edge_span with the single sample at the centre.
             const std::int64_t a = t.A[e], b = t.B[e];
@@ -125,7 +137,6 @@ inline void prepare_coverage(const TriangleSetup& t, const TileContext& c, Trian
             constexpr std::int64_t fine = std::int64_t(kBlockSize - 1) * kSubPixelScale;
             p.coarse[e] = {(a_hi + b_hi) * coarse, (a_lo + b_lo) * coarse};
             p.fine[e] = {(a_hi + b_hi) * fine, (a_lo + b_lo) * fine};
-            p.sample_offset[e][0] = 0;
         }
     }
 }
@@ -403,9 +414,36 @@ inline void count_fragments(FrameStats& stats, const BlockSamples& bs) {
     stats.fragments_depth_killed += popcount16(bs.any_cover & ~bs.any_pass);
 }
 
+// The samples of the 4x4 block at (bx, by) inside the edges in `partial`
+// (the others hold the whole block) and the viewport: bs.cover, bs.any_cover.
+template <bool MS>
+inline void block_coverage(const TriangleSetup& t, const TileContext& c, const TriangleInTile& p, int bx, int by,
+                           unsigned partial, BlockSamples& bs) {
+    const int S = samples_of<MS>(c);
+    const std::uint32_t scissor = scissor_mask(bx, by, c.width, c.height);
+    bs.any_cover = 0;
+    if (!partial) {
+        for (int s = 0; s < S; ++s) bs.cover[s] = scissor;
+        bs.any_cover = scissor;
+        return;
+    }
+    std::int64_t e0[3];
+    for (int e = 0; e < 3; ++e) e0[e] = edge_at_pixel(t, e, bx, by);
+    for (int s = 0; s < S; ++s) {
+        std::uint32_t m = scissor;
+        for (int e = 0; e < 3; ++e)
+            if (partial & (1u << e)) m &= nonnegative_mask(e0[e] + p.sample_offset[e][s], p.lane_offset[e]);
+        bs.cover[s] = m;
+        bs.any_cover |= m;
+    }
+}
+
 // Calls fn(bx, by, bs) for every 4x4 block of the tile with a covered sample
 // (bs.cover and bs.any_cover filled in), hierarchically: 16x16 blocks are
-// rejected or found inside per edge, then 4x4 blocks, then samples.
+// rejected or found inside per edge, then 4x4 blocks, then samples. A
+// triangle whose box (in this tile) lies in one 4x4 block goes to its
+// samples at once: the classifications only skip work, so the coverage is
+// the same.
 template <bool MS, class BlockFn>
 inline void for_each_block(const TriangleSetup& t, const TileContext& c, FrameStats& stats, BlockFn&& fn) {
     // The part of the tile the triangle's box overlaps (inclusive pixels).
@@ -414,9 +452,18 @@ inline void for_each_block(const TriangleSetup& t, const TileContext& c, FrameSt
     if (x0 > x1 || y0 > y1) return;
 
     TriangleInTile p;
-    prepare_coverage<MS>(t, c, p);
-    const int S = samples_of<MS>(c);
+    prepare_lanes<MS>(t, c, p);
     BlockSamples bs;
+    constexpr int kBlockMask = ~(kBlockSize - 1);
+    if ((x0 & kBlockMask) == (x1 & kBlockMask) && (y0 & kBlockMask) == (y1 & kBlockMask)) {
+        const int bx = x0 & kBlockMask, by = y0 & kBlockMask;
+        block_coverage<MS>(t, c, p, bx, by, 7u, bs);
+        if (!bs.any_cover) return;
+        ++stats.blocks_rasterized;
+        fn(bx, by, bs);
+        return;
+    }
+    prepare_spans<MS>(t, c, p);
 
     for (int cy = y0 & ~(kCoarseBlockSize - 1); cy <= y1; cy += kCoarseBlockSize) {
         for (int cx = x0 & ~(kCoarseBlockSize - 1); cx <= x1; cx += kCoarseBlockSize) {
@@ -428,8 +475,8 @@ inline void for_each_block(const TriangleSetup& t, const TileContext& c, FrameSt
                 else if (k == kEdgePartial) partial |= 1u << e;
             }
             if (out) continue;
-            const int bx_lo = std::max(cx, x0 & ~(kBlockSize - 1)), bx_hi = std::min(cx + kCoarseBlockSize - 1, x1);
-            const int by_lo = std::max(cy, y0 & ~(kBlockSize - 1)), by_hi = std::min(cy + kCoarseBlockSize - 1, y1);
+            const int bx_lo = std::max(cx, x0 & kBlockMask), bx_hi = std::min(cx + kCoarseBlockSize - 1, x1);
+            const int by_lo = std::max(cy, y0 & kBlockMask), by_hi = std::min(cy + kCoarseBlockSize - 1, y1);
             for (int by = by_lo; by <= by_hi; by += kBlockSize) {
                 for (int bx = bx_lo; bx <= bx_hi; bx += kBlockSize) {
                     unsigned block_partial = 0;
@@ -444,24 +491,8 @@ inline void for_each_block(const TriangleSetup& t, const TileContext& c, FrameSt
                         }
                         if (block_out) continue;
                     }
-                    // Iterate over fulls: with no partial edge every sample is inside.
-                    const std::uint32_t scissor = scissor_mask(bx, by, c.width, c.height);
-                    bs.any_cover = 0;
-                    if (!block_partial) {
-                        for (int s = 0; s < S; ++s) bs.cover[s] = scissor;
-                        bs.any_cover = scissor;
-                    } else {
-                        std::int64_t e0[3];
-                        for (int e = 0; e < 3; ++e) e0[e] = edge_at_pixel(t, e, bx, by);
-                        for (int s = 0; s < S; ++s) {
-                            std::uint32_t m = scissor;
-                            for (int e = 0; e < 3; ++e)
-                                if (block_partial & (1u << e))
-                                    m &= nonnegative_mask(e0[e] + p.sample_offset[e][s], p.lane_offset[e]);
-                            bs.cover[s] = m;
-                            bs.any_cover |= m;
-                        }
-                    }
+                    // With no partial edge every sample is inside.
+                    block_coverage<MS>(t, c, p, bx, by, block_partial, bs);
                     if (!bs.any_cover) continue;
                     ++stats.blocks_rasterized;
                     fn(bx, by, bs);
