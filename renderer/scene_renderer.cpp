@@ -384,6 +384,11 @@ PbrProgramExt SceneRenderer::program_ext(const FrameSettings& s, const Pass& pas
     return program_of<PbrProgramExt>(s, pass, mesh, bm);
 }
 
+PbrProgramLite SceneRenderer::program_lite(const FrameSettings& s, const Pass& pass, const Mesh& mesh,
+                                           const BoundMaterial& bm) const {
+    return program_of<PbrProgramLite>(s, pass, mesh, bm);
+}
+
 void SceneRenderer::end_pass(const FrameSettings& s, Framebuffer& fb, const ImageOutput* out, const Pass& pass) {
     // The 8-bit image: from each finished tile, unless a whole-image overlay
     // comes first (then after it, rows in parallel).

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "raster/pipeline.h"
@@ -48,6 +49,10 @@ struct FrameSettings {
     int samples = 1;  // per pixel: 1, 2, 4 or 8 (docs/pipeline.md "Anti-aliasing")
     // Where the visibility pass runs (the bytes are the same either way).
     FrameOptions::Visibility visibility = FrameOptions::Visibility::Auto;
+    // Draws that read no map run the position-and-normal varying layout
+    // (narrow_varyings_suffice(); the bytes are the same either way). Frames
+    // with stage observers always run the usual layout, which they record.
+    bool narrow_varyings = true;
 };
 
 // The 8-bit image a frame writes from its tile pass (render's PNG): exposure,
@@ -200,6 +205,9 @@ private:
     // The wide varying layout: vertex colours, UV sets past 0 (needs_extended_varyings).
     PbrProgramExt program_ext(const FrameSettings& settings, const Pass& pass, const Mesh& mesh,
                               const BoundMaterial& bm) const;
+    // The position-and-normal layout (narrow_varyings_suffice).
+    PbrProgramLite program_lite(const FrameSettings& settings, const Pass& pass, const Mesh& mesh,
+                                const BoundMaterial& bm) const;
     template <class P>
     P program_of(const FrameSettings& settings, const Pass& pass, const Mesh& mesh, const BoundMaterial& bm) const;
     // A mesh of lines or points: with its material, lit when it has normals.
@@ -251,13 +259,20 @@ void SceneRenderer::render(const FrameSettings& s, Framebuffer& fb, const ImageO
         d.state = draw_state(bm, s.view);
         const std::uint64_t drawn = std::min<std::uint64_t>(d.triangle_count, triangle_limit - first);
         taps.push_back(make_tap(d));
+        first += d.triangle_count;
+        if constexpr (std::is_same_v<Tap, NullObserver>) {
+            if (s.narrow_varyings && narrow_varyings_suffice(mesh, bm, s.view)) {
+                renderer_.submit(program_lite(s, pass, mesh, bm), d.vertex_count, mesh.indices.data(),
+                                 std::size_t(drawn) * 3, d.state, taps.back());
+                continue;
+            }
+        }
         if (needs_extended_varyings(mesh, bm))
             renderer_.submit(program_ext(s, pass, mesh, bm), d.vertex_count, mesh.indices.data(),
                              std::size_t(drawn) * 3, d.state, taps.back());
         else
             renderer_.submit(program(s, pass, mesh, bm), d.vertex_count, mesh.indices.data(), std::size_t(drawn) * 3,
                              d.state, taps.back());
-        first += d.triangle_count;
     }
     end_pass(s, fb, out, pass);
 }

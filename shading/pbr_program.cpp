@@ -53,12 +53,23 @@ BrdfTerms first_light_terms(const MaterialSample& ms, const SurfacePoint& sp, co
 
 // The varyings' arrays as the lit path's surface (the wide layout's UV sets
 // and colour too: colour only when the mesh has one).
+// The position-and-normal layout's tangents and UVs: surface_point()'s
+// constants, as lanes (packed rows hold up to kBlockLanes + 8).
+alignas(64) constexpr float kZeroLanes[kBlockLanes + 8] = {};
+alignas(64) constexpr float kOneLanes[kBlockLanes + 8] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1,
+                                                          1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+
 template <int NV>
 void set_surface(SurfaceLanes& s, const float* const* var, bool has_color) {
     s.Px = var[kVarP]; s.Py = var[kVarP + 1]; s.Pz = var[kVarP + 2];
     s.Nx = var[kVarN]; s.Ny = var[kVarN + 1]; s.Nz = var[kVarN + 2];
-    s.Tx = var[kVarT]; s.Ty = var[kVarT + 1]; s.Tz = var[kVarT + 2]; s.Tw = var[kVarT + 3];
-    s.u = var[kVarUV]; s.v = var[kVarUV + 1];
+    if constexpr (NV == kPbrVaryingsLite) {
+        s.Tx = kOneLanes; s.Ty = kZeroLanes; s.Tz = kZeroLanes; s.Tw = kOneLanes;
+        s.u = kZeroLanes; s.v = kZeroLanes;
+    } else {
+        s.Tx = var[kVarT]; s.Ty = var[kVarT + 1]; s.Tz = var[kVarT + 2]; s.Tw = var[kVarT + 3];
+        s.u = var[kVarUV]; s.v = var[kVarUV + 1];
+    }
     if constexpr (NV == kPbrVaryingsExt) {
         for (int set = 1; set < kMaxUvSets; ++set) {
             s.u_more[set - 1] = var[var_uv(set)];
@@ -69,6 +80,18 @@ void set_surface(SurfaceLanes& s, const float* const* var, bool has_color) {
         }
     } else {
         (void)has_color;
+    }
+}
+
+// Quad q's derivatives of UV set 0, from lane l of `in`, into slot.
+template <int NV>
+inline void set_derivatives(SurfaceLanes& s, const FragmentBlock<NV>& in, int l, int slot) {
+    if constexpr (NV == kPbrVaryingsLite) {
+        s.dudx[slot] = s.dvdx[slot] = s.dudy[slot] = s.dvdy[slot] = 0.0f;
+        (void)in; (void)l;
+    } else {
+        s.dudx[slot] = in.ddx(kVarUV, l); s.dvdx[slot] = in.ddx(kVarUV + 1, l);
+        s.dudy[slot] = in.ddy(kVarUV, l); s.dvdy[slot] = in.ddy(kVarUV + 1, l);
     }
 }
 
@@ -192,8 +215,7 @@ void PbrProgramT<NV>::shade_block(const FragmentBlock<kVaryings>& in, FragmentOu
     set_surface<NV>(s, var, has_color());
     for (int q = 0; q < 4; ++q) {
         const int l = 4 * q;  // the quad's derivatives, as surface_point() takes them
-        s.dudx[q] = in.ddx(kVarUV, l); s.dvdx[q] = in.ddx(kVarUV + 1, l);
-        s.dudy[q] = in.ddy(kVarUV, l); s.dvdy[q] = in.ddy(kVarUV + 1, l);
+        set_derivatives<NV>(s, in, l, q);
         set_more_derivatives<NV>(s, in, l, q);
     }
     s.back_facing = in.front_facing ? 0u : 0xFFFFu;
@@ -230,8 +252,7 @@ void PbrProgramT<NV>::shade_packed(const FragmentBlock<kVaryings>* const* in, Fr
         for (int q = 0; q < 4; ++q) {
             if (!B.quad_live(q)) continue;
             slot_of |= std::uint32_t(slots) << (8 * q);
-            s.dudx[slots] = B.ddx(kVarUV, 4 * q); s.dvdx[slots] = B.ddx(kVarUV + 1, 4 * q);
-            s.dudy[slots] = B.ddy(kVarUV, 4 * q); s.dvdy[slots] = B.ddy(kVarUV + 1, 4 * q);
+            set_derivatives<NV>(s, B, 4 * q, slots);
             set_more_derivatives<NV>(s, B, 4 * q, slots);
             ++slots;
         }
@@ -402,5 +423,6 @@ void PbrProgramT<NV>::fragment(const FragmentBlock<kVaryings>& in, FragmentOut& 
 
 template struct PbrProgramT<kPbrVaryings>;
 template struct PbrProgramT<kPbrVaryingsExt>;
+template struct PbrProgramT<kPbrVaryingsLite>;
 
 } // namespace prast

@@ -20,10 +20,14 @@ namespace prast {
 // Varying layout. A draw whose mesh has vertex colours, or whose material
 // reads a UV set past TEXCOORD_0, runs the wider layout (PbrProgramExt):
 // the first kPbrVaryings are the same, then UV sets 1 .. kMaxUvSets - 1 (two
-// floats each) and the RGBA colour. Every other draw keeps the narrow one and
-// pays for nothing more.
+// floats each) and the RGBA colour. A lit draw whose material reads no map
+// at all runs the position-and-normal layout (PbrProgramLite,
+// kPbrVaryingsLite): nothing in its shading reads a UV or a tangent, so it
+// gives the same bytes with half the varyings to interpolate and pack
+// (narrow_varyings_suffice()). Every other draw runs kPbrVaryings.
 enum : int {
     kVarP = 0, kVarN = 3, kVarUV = 6, kVarT = 8, kPbrVaryings = 12,
+    kPbrVaryingsLite = kVarUV,
     kVarUVMore = kPbrVaryings,
     kVarColor = kVarUVMore + 2 * (kMaxUvSets - 1),
     kPbrVaryingsExt = kVarColor + 4
@@ -36,7 +40,8 @@ template <int NV>
 struct PbrProgramT {
     static constexpr int kVaryings = NV;
     static constexpr bool kExtended = NV == kPbrVaryingsExt;
-    static_assert(NV == kPbrVaryings || NV == kPbrVaryingsExt, "the two layouts");
+    static constexpr bool kUvAndTangent = NV != kPbrVaryingsLite;
+    static_assert(NV == kPbrVaryingsLite || NV == kPbrVaryings || NV == kPbrVaryingsExt, "the three layouts");
 
     const Mesh* mesh = nullptr;
     glm::mat4 view_proj{1.0f};
@@ -55,10 +60,12 @@ struct PbrProgramT {
         var[kVarP + 0] = p.x; var[kVarP + 1] = p.y; var[kVarP + 2] = p.z;
         glm::vec3 n = i < mesh->normals.size() ? mesh->normals[i] : glm::vec3(0.0f, 0.0f, 1.0f);
         var[kVarN + 0] = n.x; var[kVarN + 1] = n.y; var[kVarN + 2] = n.z;
-        glm::vec2 uv = i < mesh->uvs.size() ? mesh->uvs[i] : glm::vec2(0.0f);
-        var[kVarUV + 0] = uv.x; var[kVarUV + 1] = uv.y;
-        glm::vec4 t = i < mesh->tangents.size() ? mesh->tangents[i] : glm::vec4(1.0f, 0.0f, 0.0f, 1.0f);
-        var[kVarT + 0] = t.x; var[kVarT + 1] = t.y; var[kVarT + 2] = t.z; var[kVarT + 3] = t.w;
+        if constexpr (kUvAndTangent) {
+            glm::vec2 uv = i < mesh->uvs.size() ? mesh->uvs[i] : glm::vec2(0.0f);
+            var[kVarUV + 0] = uv.x; var[kVarUV + 1] = uv.y;
+            glm::vec4 t = i < mesh->tangents.size() ? mesh->tangents[i] : glm::vec4(1.0f, 0.0f, 0.0f, 1.0f);
+            var[kVarT + 0] = t.x; var[kVarT + 1] = t.y; var[kVarT + 2] = t.z; var[kVarT + 3] = t.w;
+        }
         if constexpr (kExtended) {
             for (int set = 1; set < kMaxUvSets; ++set) {
                 const std::vector<glm::vec2>& uvs = uv_set(*mesh, set);
@@ -82,10 +89,15 @@ struct PbrProgramT {
         SurfacePoint sp;
         sp.P = {in.var[kVarP][l], in.var[kVarP + 1][l], in.var[kVarP + 2][l]};
         sp.N = {in.var[kVarN][l], in.var[kVarN + 1][l], in.var[kVarN + 2][l]};
-        sp.T = {in.var[kVarT][l], in.var[kVarT + 1][l], in.var[kVarT + 2][l], in.var[kVarT + 3][l]};
-        sp.uv = {in.var[kVarUV][l], in.var[kVarUV + 1][l]};
-        sp.duv_dx = {in.ddx(kVarUV, l), in.ddx(kVarUV + 1, l)};
-        sp.duv_dy = {in.ddy(kVarUV, l), in.ddy(kVarUV + 1, l)};
+        if constexpr (kUvAndTangent) {
+            sp.T = {in.var[kVarT][l], in.var[kVarT + 1][l], in.var[kVarT + 2][l], in.var[kVarT + 3][l]};
+            sp.uv = {in.var[kVarUV][l], in.var[kVarUV + 1][l]};
+            sp.duv_dx = {in.ddx(kVarUV, l), in.ddx(kVarUV + 1, l)};
+            sp.duv_dy = {in.ddy(kVarUV, l), in.ddy(kVarUV + 1, l)};
+        } else {  // what a mesh without UVs and tangents gives; read by nothing
+            sp.T = glm::vec4(1.0f, 0.0f, 0.0f, 1.0f);
+            sp.uv = sp.duv_dx = sp.duv_dy = glm::vec2(0.0f);
+        }
         sp.front_facing = in.front_facing;
         if constexpr (kExtended) {
             for (int set = 1; set < kMaxUvSets; ++set) {
@@ -121,12 +133,22 @@ private:
 
 using PbrProgram = PbrProgramT<kPbrVaryings>;
 using PbrProgramExt = PbrProgramT<kPbrVaryingsExt>;
+using PbrProgramLite = PbrProgramT<kPbrVaryingsLite>;
 extern template struct PbrProgramT<kPbrVaryings>;
 extern template struct PbrProgramT<kPbrVaryingsExt>;
+extern template struct PbrProgramT<kPbrVaryingsLite>;
 
 // Whether a draw of `mesh` with `bm` needs the wide layout.
 inline bool needs_extended_varyings(const Mesh& mesh, const BoundMaterial& bm) {
     return !mesh.colors.empty() || bm.reads_extra_uv_sets();
+}
+
+// Whether a draw of `mesh` with `bm`, showing `view`, may run PbrProgramLite:
+// the lit image (the UV view shows UVs), the usual layout otherwise, and no
+// map bound (only maps read UVs, and only normal maps read tangents).
+inline bool narrow_varyings_suffice(const Mesh& mesh, const BoundMaterial& bm, DebugView view) {
+    return (view == DebugView::None || view == DebugView::Tiles) && !needs_extended_varyings(mesh, bm) &&
+           !bm.reads_maps();
 }
 
 } // namespace prast

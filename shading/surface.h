@@ -87,6 +87,12 @@ struct BoundMaterial {
     const UvTransform* ext_transform_of(int map) const {
         return (ext_transformed >> map) & 1u ? &ext_xf[map] : nullptr;
     }
+    // True when any map is bound.
+    bool reads_maps() const {
+        for (const Texture* t : ext)
+            if (t) return true;
+        return base_color || metallic_roughness || roughness || metallic || normal || occlusion || emissive;
+    }
     // True when a bound map reads a UV set other than TEXCOORD_0.
     bool reads_extra_uv_sets() const {
         for (int i = 0; i < kExtMaps; ++i)

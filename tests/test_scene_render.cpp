@@ -399,4 +399,67 @@ TEST_CASE("SceneRenderer: taps see every draw, change no byte, and a triangle li
     CHECK(cut.color != plain.color);
 }
 
+TEST_CASE("SceneRenderer: draws without maps run the position-and-normal layout, with the same bytes") {
+    DefaultScene d = make_default_scene();
+    // Meshes without maps (the spheres) and with (the floor's normal map), so both layouts run.
+    Renderer r({2, 32});
+    SceneRenderer sr(d.scene, r);
+    int narrow = 0, usual = 0;
+    for (const Mesh& m : d.scene.meshes) {
+        const bool lite = narrow_varyings_suffice(m, sr.material_of(m), DebugView::None);
+        CHECK(lite == !sr.material_of(m).reads_maps());
+        CHECK_FALSE(narrow_varyings_suffice(m, sr.material_of(m), DebugView::Uv));
+        (lite ? narrow : usual)++;
+    }
+    REQUIRE(narrow > 0);
+    REQUIRE(usual > 0);
+    Mesh coloured = d.scene.meshes[0];
+    coloured.colors.assign(coloured.positions.size(), glm::vec4(1.0f));
+    CHECK_FALSE(narrow_varyings_suffice(coloured, sr.material_of(coloured), DebugView::None));
+
+    // Conductor and layered materials without maps take the scalar path: also the same bytes.
+    Scene layered = d.scene;
+    for (std::size_t i = 0; i < layered.materials.size(); ++i) {
+        Material& m = layered.materials[i];
+        if (i % 3 == 0) m.conductor = Conductor::Gold;
+        if (i % 3 == 1) {
+            m.has_clearcoat = true;
+            m.clearcoat_factor = 0.7f;
+            m.clearcoat_roughness_factor = 0.2f;
+        }
+    }
+    struct Case {
+        const Scene* scene;
+        int samples;
+        DebugView view;
+        IblMode ibl;
+    };
+    const Case cases[] = {{&d.scene, 1, DebugView::None, IblMode::SplitSum},
+                          {&d.scene, 4, DebugView::None, IblMode::SplitSum},
+                          {&d.scene, 1, DebugView::Tiles, IblMode::SplitSum},
+                          {&d.scene, 1, DebugView::None, IblMode::Reference},
+                          {&layered, 1, DebugView::None, IblMode::SplitSum},
+                          {&layered, 4, DebugView::None, IblMode::SplitSum}};
+    for (const Case& c : cases) {
+        CAPTURE(c.samples);
+        CAPTURE(int(c.view));
+        CAPTURE(int(c.ibl));
+        CAPTURE(c.scene == &layered);
+        SceneRenderer csr(*c.scene, r);
+        FrameSettings fs;
+        fs.camera = d.camera;
+        fs.lights = default_light_rig();
+        fs.samples = c.samples;
+        fs.view = c.view;
+        fs.ibl = c.ibl;
+        fs.ibl_samples = 16;
+        Framebuffer lite(96, 64), full(96, 64);
+        csr.render(fs, lite);
+        fs.narrow_varyings = false;
+        csr.render(fs, full);
+        CHECK(lite.color == full.color);
+        CHECK(lite.depth == full.depth);
+    }
+}
+
 }
