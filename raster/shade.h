@@ -83,6 +83,81 @@ inline void interpolate_lane(const TriangleSetup& t, const TriangleVaryings<NV>&
     for (int k = 0; k < NV; ++k) in.var[k][l] = p.v0[k] + w1 * p.d1[k] + w2 * p.d2[k];
 }
 
+// The live lanes (`lanes`) whose centre is outside the triangle move to the
+// centroid of their covered samples: interpolate_lane() there, eight lanes
+// at a time. Coverage by the exact integer tests of the block loop, then
+// each lane's sums in sample order, as the per-lane reference takes them.
+template <int NV>
+void interpolate_centroids(const TriangleSetup& t, const TriangleVaryings<NV>& p, const SamplePattern& sp, int bx,
+                           int by, std::uint32_t lanes, FragmentBlock<NV>& in) {
+    alignas(32) std::int64_t offset[3][kBlockLanes];
+    std::int64_t e0[3];
+    std::uint32_t centre = 0xFFFFu;
+    for (int e = 0; e < 3; ++e) {
+        lane_offsets(t.A[e], t.B[e], offset[e]);
+        e0[e] = edge_at_pixel(t, e, bx, by);
+        centre &= nonnegative_mask(e0[e], offset[e]);
+    }
+    const std::uint32_t off_centre = lanes & ~centre;
+    if (!off_centre) return;
+    in.centroid_mask = off_centre;
+    std::uint32_t cover[kMaxSamples];
+    for (int s = 0; s < sp.count; ++s) {
+        std::uint32_t m = 0xFFFFu;
+        for (int e = 0; e < 3; ++e)
+            m &= nonnegative_mask(e0[e] + std::int64_t(t.A[e]) * sp.fixed_x(s) + std::int64_t(t.B[e]) * sp.fixed_y(s),
+                                  offset[e]);
+        cover[s] = m;
+    }
+    typedef std::int32_t Int8 __attribute__((vector_size(32)));
+    const Int8 bit = {1, 2, 4, 8, 16, 32, 64, 128};
+    for (int h = 0; h < kBlockLanes; h += 8) {
+        // centre_var: every lane's centre values, copied here (a memcpy of
+        // the whole block is a rep movs, slow to start).
+        const std::uint32_t here = (off_centre >> h) & 0xFFu;
+        if (!here) {
+            for (int k = 0; k < NV; ++k) std::memcpy(in.centre_var[k] + h, in.var[k] + h, 8 * sizeof(float));
+            continue;
+        }
+        Lanes8 sum_x = {}, sum_y = {}, n = {};
+        for (int s = 0; s < sp.count; ++s) {
+            const Int8 inside = ((Int8{} + std::int32_t((cover[s] >> h) & 0xFFu)) & bit) != 0;
+            sum_x = inside ? sum_x + sp.pixel_x(s) : sum_x;
+            sum_y = inside ? sum_y + sp.pixel_y(s) : sum_y;
+            n = inside ? n + 1.0f : n;  // small integers: exact, float(n) of the reference
+        }
+        // A live lane always has a covered sample; without one it stays at the centre.
+        const Int8 move = (((Int8{} + std::int32_t(here)) & bit) != 0) & (n > 0.0f);
+        n = n > 0.0f ? n : 1.0f;
+        Int8 lx, ly;
+        for (int i = 0; i < 8; ++i) {
+            lx[i] = bx + lane_x(h + i) - t.ax;
+            ly[i] = by + lane_y(h + i) - t.ay;
+        }
+        const Lanes8 dx = __builtin_convertvector(lx, Lanes8) + sum_x / n;
+        const Lanes8 dy = __builtin_convertvector(ly, Lanes8) + sum_y / n;
+        const Lanes8 c0 = t.bary[0][0] + t.bary[0][1] * dx + t.bary[0][2] * dy;
+        const Lanes8 c1 = t.bary[1][0] + t.bary[1][1] * dx + t.bary[1][2] * dy;
+        const Lanes8 c2 = t.bary[2][0] + t.bary[2][1] * dx + t.bary[2][2] * dy;
+        // interpolate_lane(), depth_from_barycentrics() on eight lanes.
+        Lanes8 z = c0 * t.z[0] + c1 * t.z[1] + c2 * t.z[2];
+        z = z < 0.0f ? 0.0f : z;
+        z = 1.0f < z ? 1.0f : z;
+        Lanes8 old;
+        load_lanes(old, in.z + h);
+        store_lanes(in.z + h, move ? z : old);
+        const Lanes8 q0 = c0 * t.inv_w[0], q1 = c1 * t.inv_w[1], q2 = c2 * t.inv_w[2];
+        const Lanes8 r = 1.0f / (q0 + q1 + q2);
+        const Lanes8 w1 = q1 * r, w2 = q2 * r;
+        for (int k = 0; k < NV; ++k) {
+            const Lanes8 v = p.v0[k] + w1 * p.d1[k] + w2 * p.d2[k];
+            load_lanes(old, in.var[k] + h);
+            store_lanes(in.centre_var[k] + h, old);
+            store_lanes(in.var[k] + h, move ? v : old);
+        }
+    }
+}
+
 // Depth and varyings of the block's lanes at their pixel centres; with
 // several samples, the live lanes (`lanes`) whose centre is outside the
 // triangle move to the centroid of their covered samples.
@@ -121,35 +196,7 @@ void interpolate_block(const TriangleSetup& t, const TriangleVaryings<NV>& p, co
         }
     }
     in.centroid_mask = 0;
-    if (!MS) return;
-    const std::uint32_t off_centre = lanes & ~centre_coverage(t, bx, by);
-    if (!off_centre) return;
-    std::memcpy(in.centre_var, in.var, sizeof in.var);
-    in.centroid_mask = off_centre;
-    for (std::uint32_t m = off_centre; m; m &= m - 1) {
-        const int l = __builtin_ctz(m);
-        const int x = bx + lane_x(l), y = by + lane_y(l);
-        std::int64_t e0[3];
-        for (int e = 0; e < 3; ++e) e0[e] = edge_at_pixel(t, e, x, y);
-        // The centroid of the covered samples (inside the triangle, which is convex).
-        float sum_x = 0.0f, sum_y = 0.0f;
-        int n = 0;
-        for (int s = 0; s < sp.count; ++s) {
-            bool inside = true;
-            for (int e = 0; e < 3; ++e)
-                inside &= e0[e] + std::int64_t(t.A[e]) * sp.fixed_x(s) + std::int64_t(t.B[e]) * sp.fixed_y(s) >= 0;
-            if (!inside) continue;
-            sum_x += sp.pixel_x(s);
-            sum_y += sp.pixel_y(s);
-            ++n;
-        }
-        if (n == 0) continue;  // a live lane always has a covered sample; stay at the centre otherwise
-        const float dx = float(x - t.ax) + sum_x / float(n), dy = float(y - t.ay) + sum_y / float(n);
-        const float c0 = t.bary[0][0] + t.bary[0][1] * dx + t.bary[0][2] * dy;
-        const float c1 = t.bary[1][0] + t.bary[1][1] * dx + t.bary[1][2] * dy;
-        const float c2 = t.bary[2][0] + t.bary[2][1] * dx + t.bary[2][2] * dy;
-        interpolate_lane<NV>(t, p, c0, c1, c2, l, in);
-    }
+    if constexpr (MS) interpolate_centroids(t, p, sp, bx, by, lanes, in);
 }
 
 // Colour of the lanes in `mask` (one sample plane, `row` pixels wide) from
