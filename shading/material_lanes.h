@@ -165,19 +165,18 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
                     tu[l] = x.m00 * u[l] + x.m01 * v[l] + x.ox;
                     tv[l] = x.m10 * u[l] + x.m11 * v[l] + x.oy;
                 }
-                for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
-                    const int q = __builtin_ctz(qs);
-                    const float ux = x.m00 * dudx[q] + x.m01 * dvdx[q], vx = x.m10 * dudx[q] + x.m11 * dvdx[q];
-                    const float uy = x.m00 * dudy[q] + x.m01 * dvdy[q], vy = x.m10 * dudy[q] + x.m11 * dvdy[q];
-                    lambda[q] = first.lod(ux, vx, uy, vy);
+                float ux[kMaxQuadSlots], vx[kMaxQuadSlots], uy[kMaxQuadSlots], vy[kMaxQuadSlots];
+                for (int q = 0; q < kMaxQuadSlots; ++q) {
+                    ux[q] = x.m00 * dudx[q] + x.m01 * dvdx[q];
+                    vx[q] = x.m10 * dudx[q] + x.m11 * dvdx[q];
+                    uy[q] = x.m00 * dudy[q] + x.m01 * dvdy[q];
+                    vy[q] = x.m10 * dudy[q] + x.m11 * dvdy[q];
                 }
+                quad_lods(first, ux, vx, uy, vy, live_quads, lambda);
                 u = tu;
                 v = tv;
             } else {
-                for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
-                    const int q = __builtin_ctz(qs);
-                    lambda[q] = first.lod(dudx[q], dvdx[q], dudy[q], dvdy[q]);
-                }
+                quad_lods(first, dudx, dvdx, dudy, dvdy, live_quads, lambda);
             }
             TrilinearLanes at;
             prepare_trilinear_lanes<N, Isa>(first, u, v, lambda, s.quad, live, at);

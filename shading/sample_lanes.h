@@ -822,6 +822,57 @@ inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const Tr
 #endif
 }
 
+// Texture::lod() of the quads in `quads` (bits of up to kMaxQuadSlots) into
+// lambda[q], four quads per SSE instruction where AVX2 is on: the scalar
+// function's multiplies and adds in its order, its fmax, its three special
+// cases and lod_log2's table read, so the bits are the scalar ones
+// (tests/test_sample_lanes.cpp). The other entries of lambda in a group of
+// four are written too, from zero derivatives.
+inline void quad_lods(const Texture& tex, const float* dudx, const float* dvdx, const float* dudy, const float* dvdy,
+                      std::uint32_t quads, float* lambda) {
+#ifdef __AVX2__
+    const __m128 w = _mm_set1_ps(float(tex.width(0))), h = _mm_set1_ps(float(tex.height(0)));
+    const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
+    const float* table = texture_detail::kLog2Mantissa.data();
+    for (int g = 0; g < kMaxQuadSlots; g += 4) {
+        const unsigned four = (quads >> g) & 0xFu;
+        if (!four) continue;
+        // Quads outside `quads` may hold stale derivatives: zero them.
+        const __m128 keep = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(int(four)), bit), bit));
+        const __m128 ax = _mm_mul_ps(_mm_and_ps(_mm_loadu_ps(dudx + g), keep), w);
+        const __m128 bx = _mm_mul_ps(_mm_and_ps(_mm_loadu_ps(dvdx + g), keep), h);
+        const __m128 ay = _mm_mul_ps(_mm_and_ps(_mm_loadu_ps(dudy + g), keep), w);
+        const __m128 by = _mm_mul_ps(_mm_and_ps(_mm_loadu_ps(dvdy + g), keep), h);
+        const __m128 p = _mm_add_ps(_mm_mul_ps(ax, ax), _mm_mul_ps(bx, bx));
+        const __m128 q = _mm_add_ps(_mm_mul_ps(ay, ay), _mm_mul_ps(by, by));
+        // fmax(p, q): p where p >= q or q is NaN, else q.
+        const __m128 take_p = _mm_or_ps(_mm_cmp_ps(p, q, _CMP_GE_OQ), _mm_cmp_ps(q, q, _CMP_UNORD_Q));
+        const __m128 rho2 = _mm_blendv_ps(q, p, take_p);
+        // lod_log2(rho2), meaningful where rho2 is a positive normal float.
+        const __m128i bits = _mm_castps_si128(rho2);
+        const __m128 e = _mm_cvtepi32_ps(_mm_sub_epi32(_mm_srli_epi32(bits, 23), _mm_set1_epi32(127)));
+        const __m128i m = _mm_and_si128(bits, _mm_set1_epi32(0x7FFFFF));
+        const __m128i i = _mm_srli_epi32(m, 15);  // 0..255
+        const __m128 f = _mm_mul_ps(_mm_cvtepi32_ps(_mm_and_si128(m, _mm_set1_epi32(0x7FFF))), _mm_set1_ps(1.0f / 32768.0f));
+        const __m128 lo = _mm_i32gather_ps(table, i, 4), hi = _mm_i32gather_ps(table + 1, i, 4);
+        const __m128 log2 = _mm_add_ps(e, _mm_add_ps(lo, _mm_mul_ps(_mm_sub_ps(hi, lo), f)));
+        __m128 lam = _mm_mul_ps(_mm_set1_ps(0.5f), log2);
+        lam = _mm_blendv_ps(lam, _mm_set1_ps(64.0f), _mm_cmp_ps(lam, _mm_set1_ps(64.0f), _CMP_GT_OQ));
+        lam = _mm_blendv_ps(lam, _mm_set1_ps(-64.0f), _mm_cmp_ps(lam, _mm_set1_ps(-64.0f), _CMP_LT_OQ));
+        // The special cases, NaN last since it overrides the others.
+        lam = _mm_blendv_ps(lam, _mm_set1_ps(64.0f), _mm_cmp_ps(rho2, _mm_set1_ps(3.40282347e38f), _CMP_NLE_UQ));
+        lam = _mm_blendv_ps(lam, _mm_set1_ps(-64.0f), _mm_cmp_ps(rho2, _mm_set1_ps(1.17549435e-38f), _CMP_NGE_UQ));
+        lam = _mm_blendv_ps(lam, _mm_setzero_ps(), _mm_cmp_ps(rho2, rho2, _CMP_UNORD_Q));
+        _mm_storeu_ps(lambda + g, lam);
+    }
+#else
+    for (std::uint32_t qs = quads; qs; qs &= qs - 1) {
+        const int q = __builtin_ctz(qs);
+        lambda[q] = tex.lod(dudx[q], dvdx[q], dudy[q], dvdy[q]);
+    }
+#endif
+}
+
 template <int N = kBlockLanes>
 inline void fetch_trilinear_lanes(const Texture& tex, const TrilinearLanes& at, TexelLanes& out) {
     const Texture* t = &tex;

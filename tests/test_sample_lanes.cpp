@@ -500,6 +500,59 @@ TEST_CASE("texel pairs gathered in one read per lane equal the texels' bytes") {
 }
 #endif
 
+// A uv derivative: ordinary sizes over many octaves, zero, subnormal,
+// huge (squares overflow), infinite or NaN, of either sign.
+float random_derivative(std::mt19937& rng) {
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f), octave(-40.0f, 40.0f);
+    std::uniform_int_distribution<int> pick(0, 17);
+    const float near_min = std::sqrt(std::numeric_limits<float>::min()), near_max = std::sqrt(std::numeric_limits<float>::max());
+    switch (pick(rng)) {
+    case 16: return near_min * uni(rng) * 1.5f / float(1 + rng() % 2048);  // rho2 near the smallest normal
+    case 17: return near_max * uni(rng) * 1.5f / float(1 + rng() % 2048);  // rho2 near overflow
+    case 0: return std::numeric_limits<float>::quiet_NaN();
+    case 1: return std::numeric_limits<float>::infinity();
+    case 2: return -std::numeric_limits<float>::infinity();
+    case 3: return 0.0f;
+    case 4: return -0.0f;
+    case 5: return std::numeric_limits<float>::denorm_min() * float(1 + (rng() % 1000));
+    case 6: return 1e30f * uni(rng);
+    case 7: return std::ldexp(1.0f, int(octave(rng)));  // a power of two: an integer lambda
+    default: return uni(rng) * std::exp2(octave(rng));
+    }
+}
+
+TEST_CASE("quad_lods equals Texture::lod bit for bit on the quads asked for") {
+    std::mt19937 rng(7);
+    long wrong = 0, cases[4] = {};
+    const int sizes[][2] = {{1, 1}, {64, 64}, {1024, 1024}, {2048, 512}, {3, 7000}};
+    for (const auto& wh : sizes) {
+        const Texture tex = random_texture(rng, wh[0], wh[1], Wrap::Repeat, Wrap::Repeat);
+        for (int round = 0; round < 4000; ++round) {
+            float d[4][kMaxQuadSlots];
+            for (auto& row : d)
+                for (float& x : row) x = random_derivative(rng);
+            const std::uint32_t quads = rng() & ((1u << kMaxQuadSlots) - 1u);
+            float lambda[kMaxQuadSlots];
+            for (float& x : lambda) x = 12345.0f;
+            quad_lods(tex, d[0], d[1], d[2], d[3], quads, lambda);
+            for (int q = 0; q < kMaxQuadSlots; ++q) {
+                if (!((quads >> q) & 1u)) continue;
+                const float ref = tex.lod(d[0][q], d[1][q], d[2][q], d[3][q]);
+                ++cases[ref == 0.0f ? 0 : (ref == -64.0f ? 1 : (ref == 64.0f ? 2 : 3))];
+                if (bits(lambda[q]) != bits(ref)) {
+                    INFO("size " << wh[0] << "x" << wh[1] << " quad " << q << ": " << d[0][q] << " " << d[1][q] << " "
+                                 << d[2][q] << " " << d[3][q]);
+                    CHECK(lambda[q] == ref);
+                    ++wrong;
+                }
+            }
+        }
+    }
+    CHECK(wrong == 0);
+    // Every branch of Texture::lod was taken many times: NaN (or an integer 0), below the smallest normal, infinite, ordinary.
+    for (long n : cases) CHECK(n > 1000);
+}
+
 TEST_CASE("block trilinear sampling equals Texture::sample_trilinear bit for bit") {
     for (std::uint32_t seed = 1; seed <= 3000; ++seed) {
         check_sampler<16>(seed);
