@@ -63,6 +63,7 @@ struct TrilinearLanes {
     // four indices are that texel's and their weights 0, which blends 8-bit
     // (finite) texels to exactly the texel; float texels are read as is.
     std::uint32_t nearest = 0;
+    std::uint32_t levels = 0;   // bit k: a live lane reads level k
 };
 
 // True when a and b sample at the same texel indices with the same weights
@@ -331,6 +332,33 @@ inline typename V::I channel_codes(typename V::I words, int c, const std::uint16
                     V::set1_i(0xFFFF));
 }
 
+// Both taps' codes of one row for 8 lanes of a 3- or 4-channel texture
+// with Texture::unorm8_codes(): pair[c] = (code of x0) | (code of x1) << 16
+// of stored channel c, as channel_codes() and code_pair() give them. A
+// lane's 2C codes are one 16-byte load at its x0; a byte shuffle puts
+// channel c's pair in dword c, and a 4x4 transpose of dwords across the
+// four registers (lanes k and k + 4 each) gives each channel its lanes.
+template <int C>
+[[gnu::always_inline]] inline void code_pair_rows(const std::uint16_t* codes, const std::int32_t* ix, __m256i pair[4]) {
+    auto at = [&](int l) __attribute__((always_inline)) {
+        return _mm_loadu_si128(reinterpret_cast<const __m128i*>(codes + std::size_t(ix[l]) * C));
+    };
+    // dword c: bytes of words c and C + c; dwords past C zero.
+    const __m256i pick = C == 4 ? _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15,
+                                                   0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15)
+                                : _mm256_setr_epi8(0, 1, 6, 7, 2, 3, 8, 9, 4, 5, 10, 11, -1, -1, -1, -1,
+                                                   0, 1, 6, 7, 2, 3, 8, 9, 4, 5, 10, 11, -1, -1, -1, -1);
+    __m256i v[4];
+    for (int k = 0; k < 4; ++k)
+        v[k] = _mm256_shuffle_epi8(_mm256_inserti128_si256(_mm256_castsi128_si256(at(k)), at(k + 4), 1), pick);
+    const __m256i t0 = _mm256_unpacklo_epi32(v[0], v[1]), t1 = _mm256_unpacklo_epi32(v[2], v[3]);
+    const __m256i t2 = _mm256_unpackhi_epi32(v[0], v[1]), t3 = _mm256_unpackhi_epi32(v[2], v[3]);
+    pair[0] = _mm256_unpacklo_epi64(t0, t1);
+    pair[1] = _mm256_unpackhi_epi64(t0, t1);
+    pair[2] = _mm256_unpacklo_epi64(t2, t3);
+    pair[3] = _mm256_unpackhi_epi64(t2, t3);
+}
+
 #if defined(__AVX512VBMI__)
 // The sRGB code table (texture_detail::srgb_code_table()) as the low and the
 // high bytes of its 256 codes: a byte permute looks up 128 entries at once.
@@ -480,7 +508,7 @@ inline typename V::I bilerp_pairs(typename V::I top, typename V::I bottom, typen
 // Bilinear filter of every needed stored channel of one level for lanes
 // [l0, l0 + W): Texture::fix_bilinear() per lane.
 template <class V, int C, class Isa>
-[[gnu::always_inline]] inline void bilinear_unorm8(const Texture& tex, const std::uint16_t* const* srgb_codes, unsigned need,
+[[gnu::always_inline]] inline void bilinear_unorm8(const Texture& tex, const std::uint16_t* codes, const std::uint16_t* const* srgb_codes, unsigned need,
                                                    const std::int32_t (*idx)[kMaxN], const float* tx_lanes,
                                                    const float* ty_lanes, int l0, typename V::I* result) {
     using I = typename V::I;
@@ -495,6 +523,16 @@ template <class V, int C, class Isa>
     const I wy = weight_pairs<V>(weight8<V>(V::load_f(ty_lanes + l0)));
     bool needs_srgb = false;  // a needed channel is sRGB-encoded
     for (int c = 0; c < C; ++c) needs_srgb |= ((need >> c) & 1u) && srgb_codes[c];
+    if constexpr (std::is_same_v<V, Simd<8>> && (C == 3 || C == 4)) {
+        if (pairs && codes) {
+            I top[4], bottom[4];
+            code_pair_rows<C>(codes, idx[0] + l0, top);
+            code_pair_rows<C>(codes, idx[2] + l0, bottom);
+            for (int c = 0; c < C; ++c)
+                if ((need >> c) & 1u) result[c] = bilerp_pairs<V>(top[c], bottom[c], wx, wy);
+            return;
+        }
+    }
 #if defined(__AVX512VBMI__)
     if constexpr (std::is_same_v<Isa, IsaAvx512Vbmi> && (C == 3 || C == 4)) {
         if (pairs) {
@@ -591,6 +629,7 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
     using I = typename V::I;
     const std::uint16_t* srgb_codes[4] = {nullptr, nullptr, nullptr, nullptr};
     for (int c = 0; c < C; ++c) srgb_codes[c] = tex.srgb(c) ? tex.code_table(c) : nullptr;
+    const std::uint16_t* codes = W == 8 && C >= 3 ? tex.unorm8_codes(at.levels) : nullptr;
     float* dst[4] = {out.r, out.g, out.b, out.a};
     unsigned need = 0;
     for (int k = 0; k < 4; ++k)
@@ -604,11 +643,11 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
         }
         const I izero = V::set1_i(0);
         I res[4] = {izero, izero, izero, izero};
-        bilinear_unorm8<V, C, Isa>(tex, srgb_codes, need, at.ia, at.txa, at.tya, l0, res);
+        bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, at.ia, at.txa, at.tya, l0, res);
         const unsigned blend = (at.blend >> l0) & ((1u << W) - 1u);
         if (blend) {
             I resb[4] = {izero, izero, izero, izero};
-            bilinear_unorm8<V, C, Isa>(tex, srgb_codes, need, at.ib, at.txb, at.tyb, l0, resb);
+            bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, at.ib, at.txb, at.tyb, l0, resb);
             const I wt = weight_pairs<V>(weight8<V>(V::load_f(at.t + l0)));
             const I mask = V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits());
             for (int c = 0; c < C; ++c)
@@ -737,6 +776,11 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
     out.live = live;
     out.blend = 0;
     out.nearest = 0;
+    out.levels = 0;
+    for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
+        const int q = __builtin_ctz(qs);
+        out.levels |= (1u | ((blend_quads >> q) & 1u) << 1) << la[q];
+    }
     if (unpacked) {
         for (int q = 0; q < 4; ++q) {
             for (int l = 4 * q; l < 4 * q + 4; ++l) out.t[l] = t[q];

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -14,6 +16,7 @@
 
 #include "scene/det_math.h"
 #include "raster/thread_pool.h"
+#include "shading/isa.h"
 
 namespace prast {
 
@@ -245,6 +248,36 @@ void for_row_chunks(ThreadPool* pool, int rows, std::size_t row_texels, F fn) {
     });
 }
 
+// Texture::unorm8_codes() is built where the 8-lane AVX2 fetch reads it:
+// an AVX2 build without the 16-lane copy, or with it on a CPU that does not
+// run it.
+bool wants_codes16(int channels, const bool srgb[4]) {
+#if defined(__AVX2__) && !defined(PRAST_SIMD16)
+    if (channels < 3 || !(srgb[0] || srgb[1] || srgb[2] || srgb[3])) return false;
+#if PRAST_CALLS_AVX512
+    return !use_avx512();
+#else
+    return true;
+#endif
+#else
+    (void)channels;
+    (void)srgb;
+    return false;
+#endif
+}
+
+// out = code[c][byte] for the C bytes of texels [t0, t1).
+template <int C>
+void encode_codes(const std::uint8_t* bytes, std::uint16_t* out, std::size_t t0, std::size_t t1,
+                  const std::uint16_t* const code[4]) {
+    const std::uint16_t* table[C];
+    for (int c = 0; c < C; ++c) table[c] = code[c];
+    const std::uint8_t* in = bytes + t0 * C;
+    std::uint16_t* o = out + t0 * C;
+    for (std::size_t t = t0; t < t1; ++t, in += C, o += C)
+        for (int c = 0; c < C; ++c) o[c] = table[c][in[c]];
+}
+
 // Uninitialised memory for the 8-bit texels: large buffers are 2 MiB aligned
 // and advised as huge pages, so that filling them faults a few times, not
 // once per 4 KiB.
@@ -418,6 +451,16 @@ Texture Texture::from_image(Image img, Wrap s, Wrap t, ThreadPool* pool) {
     return tex;
 }
 
+struct CodeCache {
+    struct Free {
+        void operator()(std::uint8_t* p) const { std::free(p); }
+    };
+    std::unique_ptr<std::uint8_t[], Free> buffer;
+    std::atomic<std::uint32_t> ready{0};  // bit l: level l is filled
+    std::mutex lock;
+    std::uint16_t* codes() { return reinterpret_cast<std::uint16_t*>(buffer.get()); }
+};
+
 Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const bool srgb[4], const int swizzle[4],
                              int w, int h, Wrap s, Wrap t, ThreadPool* pool) {
     Texture tex;
@@ -449,9 +492,49 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const boo
         });
     }
     tex.memory_bytes_ = tex.total_texels_ * C;
+    if (wants_codes16(channels, tex.srgb_)) {
+        // Reserved whole, filled level by level on first use (unorm8_codes()):
+        // the pages of levels never read are never touched.
+        const std::size_t n = tex.total_texels_ * C;
+        st->codes = std::make_unique<CodeCache>();
+        st->codes->buffer.reset(allocate_texels((n + kCodeSlack) * sizeof(std::uint16_t)));
+        std::memset(st->codes->codes() + n, 0, kCodeSlack * sizeof(std::uint16_t));
+        tex.codes_ = st->codes.get();
+    }
     tex.bytes_ = base;
     tex.storage_ = std::move(st);
     return tex;
+}
+
+Texture::Storage::Storage() = default;
+Texture::Storage::~Storage() = default;
+
+const std::uint16_t* Texture::unorm8_codes(std::uint32_t levels) const {
+    if (!codes_) return nullptr;
+    levels &= level_count_ >= 32 ? ~0u : (1u << level_count_) - 1u;
+    if ((codes_->ready.load(std::memory_order_acquire) & levels) != levels) {
+        const std::lock_guard<std::mutex> hold(codes_->lock);
+        std::uint32_t ready = codes_->ready.load(std::memory_order_relaxed);
+        for (std::uint32_t todo = levels & ~ready; todo; todo &= todo - 1) {
+            const Level& L = levels_[__builtin_ctz(todo)];
+            const std::size_t t0 = L.offset, t1 = L.offset + std::size_t(L.width) * std::size_t(L.height);
+            if (channels_ == 3)
+                encode_codes<3>(bytes_, codes_->codes(), t0, t1, code_);
+            else
+                encode_codes<4>(bytes_, codes_->codes(), t0, t1, code_);
+        }
+        codes_->ready.store(ready | levels, std::memory_order_release);
+    }
+    return codes_->codes();
+}
+
+std::size_t Texture::code_bytes() const {
+    if (!codes_) return 0;
+    const std::uint32_t ready = codes_->ready.load(std::memory_order_acquire);
+    std::size_t texels = 0;
+    for (int l = 0; l < level_count_; ++l)
+        if ((ready >> l) & 1u) texels += std::size_t(levels_[l].width) * std::size_t(levels_[l].height);
+    return texels * std::size_t(channels_) * sizeof(std::uint16_t);
 }
 
 Texture Texture::pack_roughness_metal(const Image& rough, const Image& metal, Wrap s, Wrap t, ThreadPool* pool) {

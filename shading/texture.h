@@ -88,6 +88,8 @@ struct LevelChoice {
     bool nearest = false;
 };
 
+struct CodeCache;  // Texture::unorm8_codes(), texture.cpp
+
 class Texture {
 public:
     static constexpr int kMaxLevels = 32;
@@ -176,9 +178,21 @@ public:
     // at texel level_offset(k). For the 4x4-block sampler (sample_lanes.h).
     const glm::vec4* texel_data() const { return texels_; }
     const std::uint8_t* unorm8_data() const { return bytes_; }
+    // The codes of unorm8_data(), code_table(c)[byte] for every stored byte
+    // (channels() per texel, and kCodeSlack more), of at least the levels
+    // whose bits are set in `levels` (built on first use, once, under a lock:
+    // a frame often reads only a few levels of a large map), or null. Held
+    // only by 3- and 4-channel textures with an sRGB channel where the block
+    // sampler runs its 8-lane AVX2 loop, which then reads a lane's two taps of
+    // a row as one 16-byte load instead of a gather per tap and channel from
+    // the code table (sample_lanes.h).
+    static constexpr std::size_t kCodeSlack = 8;
+    const std::uint16_t* unorm8_codes(std::uint32_t levels) const;
     std::size_t level_offset(int level) const { return levels_[clamp_level(level)].offset; }
     // Bytes held by the texels of all levels.
     std::size_t memory_bytes() const { return memory_bytes_; }
+    // Bytes of the levels of unorm8_codes() built so far (0 without them).
+    std::size_t code_bytes() const;
 
     // lambda = log2(rho), rho = max(sqrt((dudx w)^2 + (dvdx h)^2),
     // sqrt((dudy w)^2 + (dvdy h)^2)) with the level-0 size w x h. The result is
@@ -247,10 +261,14 @@ private:
     struct Storage {
         std::vector<glm::vec4> texels;  // float storage: all levels, level 0 first, row-major
         std::unique_ptr<std::uint8_t[], FreeBytes> bytes;  // 8-bit storage, same order
+        std::unique_ptr<CodeCache> codes;  // unorm8_codes(), or null
+        Storage();
+        ~Storage();
     };
     std::shared_ptr<const Storage> storage_;
     const glm::vec4* texels_ = nullptr;   // storage_->texels
     const std::uint8_t* bytes_ = nullptr; // storage_->bytes
+    CodeCache* codes_ = nullptr;          // storage_->codes
     int channels_ = 0;               // 0: float storage
     int swizzle_[4] = {0, 1, 2, 3};
     const float* table_[4] = {nullptr, nullptr, nullptr, nullptr};

@@ -327,6 +327,49 @@ TEST_CASE("roughness and metal maps packed into one texture sample as the two ap
     CHECK_THROWS_AS(Texture::pack_roughness_metal(a, to_float(a)), std::invalid_argument);
 }
 
+TEST_CASE("unorm8_codes holds each stored byte's code, built per level on first use") {
+    std::mt19937 rng(83u);
+    for (int channels : {1, 2, 3, 4}) {
+        for (bool srgb : {false, true}) {
+            const Image img = random_unorm8(rng, 77, 45, channels, srgb);
+            const Texture tex = Texture::from_image(img, Wrap::Repeat, Wrap::Repeat);
+            const std::uint16_t* codes = tex.unorm8_codes(0u);
+            if (channels < 3 || !srgb) {
+                // Those fetch through shifts or one gather per tap, not the copy.
+                CHECK(codes == nullptr);
+                CHECK(tex.code_bytes() == 0);
+                continue;
+            }
+            if (!codes) {
+                MESSAGE("no 16-bit codes in this process (the AVX-512 fetch runs, or no AVX2)");
+                continue;
+            }
+            CHECK(tex.code_bytes() == 0);
+            // Levels 1 and 3 first, then all: each level's codes are code_table(c)[byte].
+            const std::uint32_t some = 0xAu, all = (1u << tex.levels()) - 1u;
+            for (std::uint32_t levels : {some, all}) {
+                codes = tex.unorm8_codes(levels);
+                std::size_t texels = 0;
+                for (int l = 0; l < tex.levels(); ++l) {
+                    if (!((levels >> l) & 1u)) continue;
+                    const std::size_t n = std::size_t(tex.width(l)) * std::size_t(tex.height(l));
+                    texels += n;
+                    const std::size_t first = tex.level_offset(l) * std::size_t(channels);
+                    for (std::size_t i = first; i < first + n * std::size_t(channels); ++i) {
+                        const int c = int(i % std::size_t(channels));
+                        REQUIRE(codes[i] == tex.code_table(c)[tex.unorm8_data()[i]]);
+                    }
+                }
+                CHECK(tex.code_bytes() == texels * std::size_t(channels) * 2);
+            }
+            // A view through another sampler shares them.
+            SamplerState clamp;
+            clamp.wrap_s = clamp.wrap_t = Wrap::ClampToEdge;
+            CHECK(tex.with_sampler(clamp).unorm8_codes(all) == codes);
+        }
+    }
+}
+
 TEST_CASE("mip chains are the same bytes on any thread count") {
     std::mt19937 rng(82u);
     ThreadPool one(1), three(3);
