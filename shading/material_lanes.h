@@ -172,11 +172,11 @@ inline std::uint32_t sample_material_lanes(const BoundMaterial& bm, const Surfac
                     uy[q] = x.m00 * dudy[q] + x.m01 * dvdy[q];
                     vy[q] = x.m10 * dudy[q] + x.m11 * dvdy[q];
                 }
-                quad_lods(first, ux, vx, uy, vy, live_quads, lambda);
+                quad_lods<Isa>(first, ux, vx, uy, vy, live_quads, lambda);
                 u = tu;
                 v = tv;
             } else {
-                quad_lods(first, dudx, dvdx, dudy, dvdy, live_quads, lambda);
+                quad_lods<Isa>(first, dudx, dvdx, dudy, dvdy, live_quads, lambda);
             }
             TrilinearLanes at;
             prepare_trilinear_lanes<N, Isa>(first, u, v, lambda, s.quad, live, at);

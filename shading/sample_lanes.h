@@ -338,7 +338,7 @@ inline typename V::I channel_codes(typename V::I words, int c, const std::uint16
 // lane's 2C codes are one 16-byte load at its x0; a byte shuffle puts
 // channel c's pair in dword c, and a 4x4 transpose of dwords across the
 // four registers (lanes k and k + 4 each) gives each channel its lanes.
-template <int C>
+template <class Isa, int C>
 [[gnu::always_inline]] inline void code_pair_rows(const std::uint16_t* codes, const std::int32_t* ix, __m256i pair[4]) {
     auto at = [&](int l) __attribute__((always_inline)) {
         return _mm_loadu_si128(reinterpret_cast<const __m128i*>(codes + std::size_t(ix[l]) * C));
@@ -526,8 +526,8 @@ template <class V, int C, class Isa>
     if constexpr (std::is_same_v<V, Simd<8>> && (C == 3 || C == 4)) {
         if (pairs && codes) {
             I top[4], bottom[4];
-            code_pair_rows<C>(codes, idx[0] + l0, top);
-            code_pair_rows<C>(codes, idx[2] + l0, bottom);
+            code_pair_rows<Isa, C>(codes, idx[0] + l0, top);
+            code_pair_rows<Isa, C>(codes, idx[2] + l0, bottom);
             for (int c = 0; c < C; ++c)
                 if ((need >> c) & 1u) result[c] = bilerp_pairs<V>(top[c], bottom[c], wx, wy);
             return;
@@ -872,10 +872,11 @@ inline void fetch_trilinear_lanes(const Texture* const* tex, int count, const Tr
 // cases and lod_log2's table read, so the bits are the scalar ones
 // (tests/test_sample_lanes.cpp). The other entries of lambda in a group of
 // four are written too, from zero derivatives.
+template <class Isa = IsaDefault>
 inline void quad_lods(const Texture& tex, const float* dudx, const float* dvdx, const float* dudy, const float* dvdy,
                       std::uint32_t quads, float* lambda) {
 #ifdef __AVX2__
-    const __m128 w = _mm_set1_ps(float(tex.width(0))), h = _mm_set1_ps(float(tex.height(0)));
+    const __m128 w = _mm_set1_ps(tex.lod_width()), h = _mm_set1_ps(tex.lod_height());
     const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
     const float* table = texture_detail::kLog2Mantissa.data();
     for (int g = 0; g < kMaxQuadSlots; g += 4) {

@@ -198,6 +198,9 @@ public:
     // sqrt((dudy w)^2 + (dvdy h)^2)) with the level-0 size w x h. The result is
     // finite: clamped to [-64, 64] (zero derivatives give -64), NaN gives 0.
     float lod(float dudx, float dvdx, float dudy, float dvdy) const;
+    // The level-0 size as lod() scales the derivatives by it.
+    float lod_width() const { return levels_[0].fwidth; }
+    float lod_height() const { return levels_[0].fheight; }
 
     // Bilinear filter of one level (clamped to the valid range).
     glm::vec4 sample_bilinear(float u, float v, int level) const;

@@ -534,7 +534,7 @@ TEST_CASE("quad_lods equals Texture::lod bit for bit on the quads asked for") {
             const std::uint32_t quads = rng() & ((1u << kMaxQuadSlots) - 1u);
             float lambda[kMaxQuadSlots];
             for (float& x : lambda) x = 12345.0f;
-            quad_lods(tex, d[0], d[1], d[2], d[3], quads, lambda);
+            quad_lods<>(tex, d[0], d[1], d[2], d[3], quads, lambda);
             for (int q = 0; q < kMaxQuadSlots; ++q) {
                 if (!((quads >> q) & 1u)) continue;
                 const float ref = tex.lod(d[0][q], d[1][q], d[2][q], d[3][q]);
