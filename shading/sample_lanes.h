@@ -773,6 +773,14 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
             nearest_quads |= std::uint32_t(c.nearest) << q;
         }
     }
+    // Quads without a live lane read a live quad's level (their lanes are
+    // dropped): every lane then reads a level in out.levels, the levels whose
+    // 16-bit codes the fetch has filled (Texture::unorm8_codes()).
+    {
+        const int q_live = live_quads ? __builtin_ctz(live_quads) : 0;
+        for (int q = 0; q < kMaxQuadSlots; ++q)
+            if (!((live_quads >> q) & 1u)) la[q] = la[q_live];
+    }
     out.live = live;
     out.blend = 0;
     out.nearest = 0;
