@@ -415,7 +415,7 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
                                  b.emissive})
             if (t && std::find(seen.begin(), seen.end(), t) == seen.end()) {
                 seen.push_back(t);
-                r.texture_bytes += t->memory_bytes() + t->code_bytes();
+                r.texture_bytes += t->memory_bytes();
             }
 
     FrameSettings fs = lw.settings;
