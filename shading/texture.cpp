@@ -509,8 +509,7 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const boo
 Texture::Storage::Storage() = default;
 Texture::Storage::~Storage() = default;
 
-const std::uint16_t* Texture::unorm8_codes(std::uint32_t levels) const {
-    if (!codes_) return nullptr;
+const std::uint16_t* Texture::filled_codes(std::uint32_t levels) const {
     levels &= level_count_ >= 32 ? ~0u : (1u << level_count_) - 1u;
     if ((codes_->ready.load(std::memory_order_acquire) & levels) != levels) {
         const std::lock_guard<std::mutex> hold(codes_->lock);

@@ -187,7 +187,7 @@ public:
     // a row as one 16-byte load instead of a gather per tap and channel from
     // the code table (sample_lanes.h).
     static constexpr std::size_t kCodeSlack = 8;
-    const std::uint16_t* unorm8_codes(std::uint32_t levels) const;
+    const std::uint16_t* unorm8_codes(std::uint32_t levels) const { return codes_ ? filled_codes(levels) : nullptr; }
     std::size_t level_offset(int level) const { return levels_[clamp_level(level)].offset; }
     // Bytes held by the texels of all levels.
     std::size_t memory_bytes() const { return memory_bytes_; }
@@ -228,6 +228,8 @@ private:
         std::size_t offset = 0;  // first texel in texels_
     };
 
+    // unorm8_codes() with codes_ set: fills the levels not filled yet.
+    const std::uint16_t* filled_codes(std::uint32_t levels) const;
     int clamp_level(int level) const {
         return level < 0 ? 0 : (level >= level_count_ ? level_count_ - 1 : level);
     }
