@@ -19,7 +19,7 @@
 //                                        each thread count and sample count in turn
 //   bench --psnr A.png B.png
 //
-// The workloads (1920x1080, one sun, ambient 0.05, ACES): quad (two triangles
+// The workloads (1920x1080 unless --size, one sun, ambient 0.05, ACES): quad (two triangles
 // filling the frame, four 1024x1024 PNG maps from OBJ+MTL, repeated three
 // times across: about 1.5 texels a pixel), grid (480x270 quads = 259,200
 // triangles of about 8 pixels, constant material), bottle (a revolved profile
@@ -306,6 +306,7 @@ struct Workload {
     glm::vec3 eye, target;
     float fov;
     bool own_lights;      // the built-in scene keeps its sun and point light
+    int width = 1920, height = 1080;  // bench --size
 };
 
 const char* kSun = "0.35,0.6,0.7:3,3,3";
@@ -331,7 +332,8 @@ std::vector<std::string> render_args(const Workload& w) {
     std::snprintf(fov, sizeof fov, "%g", double(w.fov));
     std::vector<std::string> a;
     if (!w.file.empty()) a = {w.file, "--eye", eye, "--target", target, "--fov", fov, "--sun", kSun};
-    a.insert(a.end(), {"--size", "1920x1080", "--ambient", "0.05,0.05,0.05", "--tonemap", "aces"});
+    a.insert(a.end(), {"--size", std::to_string(w.width) + "x" + std::to_string(w.height), "--ambient",
+                       "0.05,0.05,0.05", "--tonemap", "aces"});
     return a;
 }
 
@@ -359,7 +361,7 @@ struct Result {
     std::size_t triangles = 0;
     double load_ms = 0, textures_ms = 0;
     std::size_t texture_bytes = 0;
-    int samples = 1;
+    int samples = 1, width = 0, height = 0;
     Summary frame, vertex, setup_bin, raster;  // frame: draws and the tile-pass resolve, as render's
     double png_ms = 0;
     std::size_t png_bytes = 0;
@@ -398,6 +400,8 @@ Result measure(const Workload& w, int threads, int tile, int repeat, int width, 
     Result r;
     r.name = w.name;
     r.samples = samples;
+    r.width = width;
+    r.height = height;
     auto t_load = Clock::now();
     LoadedWorkload lw;
     load_workload(w, samples, lw);
@@ -547,10 +551,10 @@ std::string json_result(const Result& r) {
     };
     char b[512];
     std::snprintf(b, sizeof b,
-                  "{\"workload\":\"%s\",\"threads\":%d,\"msaa\":%d,\"triangles\":%zu,\"coverage\":%.4f,\"load_ms\":%.3f,"
+                  "{\"workload\":\"%s\",\"threads\":%d,\"msaa\":%d,\"width\":%d,\"height\":%d,\"triangles\":%zu,\"coverage\":%.4f,\"load_ms\":%.3f,"
                   "\"textures_ms\":%.3f,\"texture_bytes\":%zu,\"png_ms\":%.3f,\"png_bytes\":%zu,",
-                  r.name.c_str(), r.threads, r.samples, r.triangles, r.coverage, r.load_ms, r.textures_ms,
-                  r.texture_bytes, r.png_ms, r.png_bytes);
+                  r.name.c_str(), r.threads, r.samples, r.width, r.height, r.triangles, r.coverage, r.load_ms,
+                  r.textures_ms, r.texture_bytes, r.png_ms, r.png_bytes);
     return std::string(b) + "\"frame_ms\":" + s(r.frame) + ",\"vertex_ms\":" + s(r.vertex) +
            ",\"setup_bin_ms\":" + s(r.setup_bin) + ",\"raster_shade_ms\":" + s(r.raster) + "}";
 }
@@ -824,7 +828,9 @@ int main(int argc, char** argv) {
         if (!write_dir.empty()) {
             ensure_workloads(write_dir, true);
             std::ofstream cmds(fs::path(write_dir) / "commands.txt");
-            for (const Workload& w : workloads(fs::absolute(write_dir), fs::absolute(assets))) {
+            for (Workload w : workloads(fs::absolute(write_dir), fs::absolute(assets))) {
+                w.width = width;
+                w.height = height;
                 std::string line = "render";
                 for (const std::string& arg : render_args(w)) line += " " + shell_quote(arg);
                 cmds << w.name << ": " << line << "\n";
@@ -835,8 +841,10 @@ int main(int argc, char** argv) {
         const std::vector<Workload> all = workloads(dir, assets);
         ensure_workloads(dir, false);
         std::vector<Workload> list;
-        for (const Workload& w : all) {
+        for (Workload w : all) {
             if (!names.empty() && std::find(names.begin(), names.end(), w.name) == names.end()) continue;
+            w.width = width;
+            w.height = height;
             if (!w.file.empty() && !fs::exists(w.file)) {
                 std::fprintf(stderr, "bench: skipping %s: %s not found (--assets DIR)\n", w.name.c_str(),
                              w.file.c_str());
