@@ -44,6 +44,7 @@ enum class Zone { Grout, Bevel, Face };
 
 struct BrickPoint {
     std::uint32_t id = 0;  // hash of the (wrapped) brick coordinates
+    int cell = 0;          // the wrapped brick coordinates, col + row * kBrickCols
     Zone zone = Zone::Face;
     float t = 0.0f;        // position across the zone, 0 at its inner (grout-side) edge
     glm::vec2 inward{0.0f};  // uv direction in which the distance to the brick edge grows
@@ -58,8 +59,10 @@ BrickPoint brick_at(glm::vec2 uv) {
     const int icol = int(col);
 
     BrickPoint p;
-    p.id = hash3(((icol % kBrickCols) + kBrickCols) % kBrickCols,
-                 ((irow % kBrickRows) + kBrickRows) % kBrickRows, 17U);
+    const int wcol = ((icol % kBrickCols) + kBrickCols) % kBrickCols;
+    const int wrow = ((irow % kBrickRows) + kBrickRows) % kBrickRows;
+    p.id = hash3(wcol, wrow, 17U);
+    p.cell = wcol + wrow * kBrickCols;
     // Distances to the nearest vertical and horizontal brick edges, in H.
     const float dx = std::min(fx, 1.0f - fx) * 2.0f;
     const float dy = std::min(fy, 1.0f - fy);
@@ -117,6 +120,48 @@ BrickLook brick_look(std::uint32_t id) {
     return look;
 }
 
+// brick_look of every brick, computed once: the images ask for it at every
+// sub-sample.
+const BrickLook& look_of(const BrickPoint& p) {
+    static const struct Looks {
+        BrickLook look[kBrickCols * kBrickRows];
+        Looks() {
+            for (int r = 0; r < kBrickRows; ++r)
+                for (int c = 0; c < kBrickCols; ++c) look[c + r * kBrickCols] = brick_look(hash3(c, r, 17U));
+        }
+    } looks;
+    return looks.look[p.cell];
+}
+
+// value_noise's interpolation of lattice values at(i, j), i and j wrapped to
+// [0, period).
+template <class At> float lattice_noise(glm::vec2 uv, int period, At at) {
+    const float x = uv.x * float(period), y = uv.y * float(period);
+    const float fx = std::floor(x), fy = std::floor(y);
+    const int ix = int(fx), iy = int(fy);
+    auto wrap = [period](int i) { return ((i % period) + period) % period; };
+    auto smooth = [](float t) { return t * t * (3.0f - 2.0f * t); };
+    const float sx = smooth(x - fx), sy = smooth(y - fy);
+    const int x0 = wrap(ix), x1 = wrap(ix + 1), y0 = wrap(iy), y1 = wrap(iy + 1);
+    const float top = at(x0, y0) + (at(x1, y0) - at(x0, y0)) * sx;
+    const float bottom = at(x0, y1) + (at(x1, y1) - at(x0, y1)) * sx;
+    return top + (bottom - top) * sy;
+}
+
+float lattice_value_of(int x, int y, std::uint32_t seed, NoiseLattice lattice);
+
+// value_noise(uv, Period, Seed) with the lattice's values held in a table.
+template <int Period, std::uint32_t Seed> float table_noise(glm::vec2 uv) {
+    static const struct Table {
+        float v[Period * Period];
+        Table() {
+            for (int j = 0; j < Period; ++j)
+                for (int i = 0; i < Period; ++i) v[i + j * Period] = lattice_value_of(i, j, Seed, NoiseLattice::Mixed);
+        }
+    } table;
+    return lattice_noise(uv, Period, [](int i, int j) { return table.v[i + j * Period]; });
+}
+
 // Renders f(uv) -> vec4 with 2x2 sub-samples per texel averaged: smoother
 // grout edges at small sizes; the mip chain does the rest.
 template <class F>
@@ -141,24 +186,20 @@ constexpr float kGroutAlbedo = 0.28f;
 
 } // namespace
 
-float lattice_value(int x, int y, std::uint32_t seed, NoiseLattice lattice) {
+namespace {
+float lattice_value_of(int x, int y, std::uint32_t seed, NoiseLattice lattice) {
     if (lattice == NoiseLattice::Linear)
         return unit_float(hash_u32(std::uint32_t(x) * 73856093U ^ std::uint32_t(y) * 19349663U ^ seed));
     return unit_float(hash3(x, y, seed));
 }
+} // namespace
+
+float lattice_value(int x, int y, std::uint32_t seed, NoiseLattice lattice) {
+    return lattice_value_of(x, y, seed, lattice);
+}
 
 float value_noise(glm::vec2 uv, int period, std::uint32_t seed, NoiseLattice lattice) {
-    const float x = uv.x * float(period), y = uv.y * float(period);
-    const float fx = std::floor(x), fy = std::floor(y);
-    const int ix = int(fx), iy = int(fy);
-    auto at = [&](int i, int j) {
-        return lattice_value(((i % period) + period) % period, ((j % period) + period) % period, seed, lattice);
-    };
-    auto smooth = [](float t) { return t * t * (3.0f - 2.0f * t); };
-    const float sx = smooth(x - fx), sy = smooth(y - fy);
-    const float top = at(ix, iy) + (at(ix + 1, iy) - at(ix, iy)) * sx;
-    const float bottom = at(ix, iy + 1) + (at(ix + 1, iy + 1) - at(ix, iy + 1)) * sx;
-    return top + (bottom - top) * sy;
+    return lattice_noise(uv, period, [&](int i, int j) { return lattice_value_of(i, j, seed, lattice); });
 }
 
 Image make_checker(int size, int cells, glm::vec4 a, glm::vec4 b) {
@@ -182,11 +223,11 @@ Image make_tiles_albedo(int size) {
     return render_procedural(size, [](glm::vec2 uv) {
         const BrickPoint p = brick_at(uv);
         if (p.zone == Zone::Grout) {
-            const float grit = value_noise(uv, 128, 3U);
+            const float grit = table_noise<128, 3U>(uv);
             return glm::vec4(glm::vec3(kGroutAlbedo * (0.8f + 0.4f * grit)), 1.0f);
         }
-        const BrickLook look = brick_look(p.id);
-        const float mottle = value_noise(uv, 32, 5U);
+        const BrickLook& look = look_of(p);
+        const float mottle = table_noise<32, 5U>(uv);
         // Edges slightly darker where the glaze runs thin.
         const float edge = p.zone == Zone::Bevel ? 0.85f + 0.15f * p.t : 1.0f;
         return glm::vec4(glm::min(look.albedo * ((0.92f + 0.16f * mottle) * edge), glm::vec3(1.0f)), 1.0f);
@@ -204,10 +245,10 @@ Image make_tiles_normal(int size) {
             grad = p.inward * (0.3f * p.t);
             break;
         case Zone::Bevel:  // rounded edge: steepest next to the grout, flat at the face
-            grad = p.inward * (1.1f * (1.0f - p.t)) + brick_look(p.id).tilt;
+            grad = p.inward * (1.1f * (1.0f - p.t)) + look_of(p).tilt;
             break;
         case Zone::Face:
-            grad = brick_look(p.id).tilt;
+            grad = look_of(p).tilt;
             break;
         }
         // Tangent space: x along T = +u, y along B = -v (up the image), so
@@ -228,12 +269,12 @@ Image make_tiles_roughness_metal(int size) {
     return render_procedural(size, [](glm::vec2 uv) {
         const BrickPoint p = brick_at(uv);
         if (p.zone == Zone::Grout) {
-            const float grit = value_noise(uv, 128, 3U);
+            const float grit = table_noise<128, 3U>(uv);
             return glm::vec4(0.55f + 0.15f * p.t, 0.85f + 0.1f * grit, 0.0f, 1.0f);
         }
-        const BrickLook look = brick_look(p.id);
+        const BrickLook& look = look_of(p);
         const float ao = p.zone == Zone::Bevel ? 0.85f + 0.15f * p.t : 1.0f;
-        const float wear = value_noise(uv, 32, 9U);
+        const float wear = table_noise<32, 9U>(uv);
         return glm::vec4(ao, look.roughness * (0.9f + 0.2f * wear), look.metallic, 1.0f);
     });
 }
