@@ -30,6 +30,7 @@
 #include <stb_image.h>
 #include <turbojpeg.h>
 #include <webp/decode.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include "scene/det_math.h"
@@ -316,6 +317,19 @@ int unfilter_rows(const unsigned char* raw, unsigned char* pixels, std::size_t n
     return -1;
 }
 
+// Reserves n bytes for v, on transparent huge pages where the kernel offers
+// them on request (THP "madvise" mode): a 2048x2048 RGB map's buffer is
+// otherwise ~3,000 page faults, which cost more than inflating it.
+void reserve_huge(std::vector<std::uint8_t>& v, std::size_t n) {
+    v.reserve(n);
+#ifdef MADV_HUGEPAGE
+    constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+    const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
+    const std::uintptr_t e = (reinterpret_cast<std::uintptr_t>(v.data()) + v.capacity()) & ~(kHuge - 1);
+    if (e > b) madvise(reinterpret_cast<void*>(b), e - b, MADV_HUGEPAGE);
+#endif
+}
+
 // The zlib header (RFC 1950) of a PNG's image data: deflate, a window of at
 // most 32 KiB, no preset dictionary, its check bits right.
 bool png_zlib_header_ok(unsigned char cmf, unsigned char flg) {
@@ -338,7 +352,7 @@ bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h
         const std::uint32_t len = be32(data + pos);
         if (len > size - pos - 12) return false;
         const unsigned char* type = data + pos + 4;
-        if (std::uint32_t(crc32(0L, type, uInt(len + 4))) != be32(data + pos + 8 + len)) return false;
+        if (std::uint32_t(libdeflate_crc32(0, type, len + 4)) != be32(data + pos + 8 + len)) return false;
         if (std::memcmp(type, "IDAT", 4) == 0) compressed.insert(compressed.end(), type + 4, type + 4 + len);
         else if (!compressed.empty() || std::memcmp(type, "IEND", 4) == 0) break;  // IDATs are consecutive
         pos += 12 + std::size_t(len);
@@ -349,16 +363,23 @@ bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h
     };
     const std::unique_ptr<libdeflate_decompressor, Free> inflater(libdeflate_alloc_decompressor());
     if (!inflater) return false;
-    std::vector<unsigned char> raw(raw_size + 4);  // 4 spare bytes for unfilter_row's 4-byte reads
+    // One buffer: the filtered rows are inflated two rows of pixels past its
+    // start and unfiltered in place. Pixel row y (and y + 1, which the Paeth
+    // pair writes while still reading filtered row y) then ends before
+    // filtered row y begins: no write reaches a byte still to be read.
+    const std::size_t lead = 2 * stride;
+    reserve_huge(img.pixels, lead + raw_size + 4);  // 4 spare bytes for unfilter_row's 4-byte reads
+    img.pixels.resize(lead + raw_size + 4);
+    unsigned char* raw = img.pixels.data() + lead;
     std::size_t in_used = 0, out_made = 0;
     // The raw deflate stream after the header; its Adler-32 is not checked
     // (the chunk CRCs guard the bytes), as on the zlib path.
-    if (libdeflate_deflate_decompress_ex(inflater.get(), compressed.data() + 2, compressed.size() - 2, raw.data(),
+    if (libdeflate_deflate_decompress_ex(inflater.get(), compressed.data() + 2, compressed.size() - 2, raw,
                                          raw_size, &in_used, &out_made) != LIBDEFLATE_SUCCESS ||
         out_made != raw_size)
         return false;
     compressed = {};
-    return unfilter_rows(raw.data(), img.pixels.data(), stride, 0, h, channels) < 0;
+    return unfilter_rows(raw, img.pixels.data(), stride, 0, h, channels) < 0;
 }
 
 FastPng decode_png_fast(const unsigned char* data, std::size_t size, int w, int h, Image& img, std::string& error) {
@@ -388,7 +409,6 @@ FastPng decode_png_fast(const unsigned char* data, std::size_t size, int w, int 
     if (!channels || !seen_idat) return FastPng::NotMine;
 
     const std::size_t stride = std::size_t(w) * std::size_t(channels);
-    img.pixels.resize(stride * std::size_t(h) + 4);  // 4 spare bytes for the 4-byte reads
     // First libdeflate, in one call over the whole image (2 to 3 times zlib's
     // speed): the IDAT data gathered, every CRC checked, the zlib header
     // checked, the rows inflated into one buffer of exactly the image's size
@@ -402,6 +422,7 @@ FastPng decode_png_fast(const unsigned char* data, std::size_t size, int w, int 
         img.channels = channels;
         return FastPng::Done;
     }
+    img.pixels.resize(stride * std::size_t(h) + 4);  // 4 spare bytes for the 4-byte reads
 
     // Inflate the IDAT chunks into `raw`, many rows at a time (zlib copies
     // what each call writes into its 32 KiB window: calls of a few hundred KiB
@@ -427,7 +448,7 @@ FastPng decode_png_fast(const unsigned char* data, std::size_t size, int w, int 
             const std::uint32_t len = be32(data + pos);
             if (len > size - pos - 12) return false;
             const unsigned char* type = data + pos + 4;
-            if (std::uint32_t(crc32(0L, type, uInt(len + 4))) != be32(data + pos + 8 + len)) {
+            if (std::uint32_t(libdeflate_crc32(0, type, len + 4)) != be32(data + pos + 8 + len)) {
                 error = std::string("CRC error in the ") + std::string(reinterpret_cast<const char*>(type), 4) +
                         " chunk";
                 return false;

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -130,9 +132,16 @@ double srgb_decode_exact(double c) {
 // the value (ties round up), with decode the exact sRGB transfer function in
 // double. A 4097-entry table of the answer at i / 4096 gives the start of a
 // search that then steps up at most a couple of times.
+//
+// The 2x2 case works in integers: each decoded byte (a float, a multiple of
+// 2^-35 below 1) is value[b] = decoded * 2^35 exactly, a sum S of four is
+// exact, and its mean S * 2^-37 >= T_k exactly when S >= ceil(T_k * 2^37).
+// So encode_sum4(S) is encode(S * 2^-37) without a conversion to double.
 struct SrgbEncoder {
     double threshold[256];      // [255] = +inf, a sentinel
     std::uint8_t start[4097];
+    std::uint64_t value[256];            // srgb8_decode_table() * 2^35
+    std::uint64_t threshold_sum4[256];   // ceil(threshold * 2^37); [255] a sentinel
 
     SrgbEncoder() {
         for (int k = 0; k < 255; ++k) threshold[k] = srgb_decode_exact((double(k) + 0.5) / 255.0);
@@ -142,6 +151,19 @@ struct SrgbEncoder {
             while (b < 255 && double(i) / 4096.0 >= threshold[b]) ++b;
             start[i] = std::uint8_t(b);
         }
+        const float* srgb = srgb8_decode_table();
+        for (int k = 0; k < 256; ++k) {
+            value[k] = std::uint64_t(std::ldexp(double(srgb[k]), 35));
+            // Not a multiple of 2^-35 (a different table): the integer path would round.
+            if (std::ldexp(double(value[k]), -35) != double(srgb[k])) std::abort();
+            threshold_sum4[k] = k < 255 ? std::uint64_t(std::ceil(std::ldexp(threshold[k], 37))) : ~std::uint64_t(0);
+        }
+    }
+    // The byte of the mean of four decoded bytes, from the sum of their value[].
+    std::uint8_t encode_sum4(std::uint64_t sum) const {
+        int b = start[sum >> 25];  // int(mean * 4096), the mean at most 1
+        while (sum >= threshold_sum4[b]) ++b;
+        return std::uint8_t(b);
     }
     std::uint8_t encode(double linear) const {
         const double x = linear < 0.0 ? 0.0 : (linear > 1.0 ? 1.0 : linear);
@@ -162,15 +184,13 @@ const SrgbEncoder& srgb_encoder() {
 // multiple of 2^-35 below 1), so their order is free.
 template <int C, bool Srgb>
 void downsample_2x2_row(const std::uint8_t* r0, const std::uint8_t* r1, std::uint8_t* out, int dw) {
-    const float* srgb = srgb8_decode_table();
     const SrgbEncoder& enc = srgb_encoder();
+    const std::uint64_t* value = enc.value;
     constexpr int kAlpha = C == 2 ? 1 : (C == 4 ? 3 : -1);
     for (int i = 0; i < dw; ++i, r0 += 2 * C, r1 += 2 * C, out += C) {
         for (int c = 0; c < C; ++c) {
             if (Srgb && c != kAlpha) {
-                const double sum = (double(srgb[r0[c]]) + double(srgb[r0[C + c]])) +
-                                   (double(srgb[r1[c]]) + double(srgb[r1[C + c]]));
-                out[c] = enc.encode(sum * 0.25);
+                out[c] = enc.encode_sum4(value[r0[c]] + value[r0[C + c]] + value[r1[c]] + value[r1[C + c]]);
             } else {
                 out[c] = std::uint8_t((r0[c] + r0[C + c] + r1[c] + r1[C + c] + 2) >> 2);
             }
