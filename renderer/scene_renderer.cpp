@@ -131,7 +131,9 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer, DecodedImag
                 std::lock_guard<std::mutex> lock(kept->mutex);
                 if (kept->slots.size() > slot) have = kept->slots[slot];
             }
-            images[slot] = src.decoded ? *src.decoded : have ? *have : decode_image(src, slot % 2 == 1);
+            // A map drawn as it is decodes with room for its mip chain (no copy of level 0).
+            const PixelCapacity room = direct[slot] ? &Texture::unorm8_bytes : nullptr;
+            images[slot] = src.decoded ? *src.decoded : have ? *have : decode_image(src, slot % 2 == 1, room);
             if (kept && !src.decoded && !have) {
                 auto copy = std::make_shared<const Image>(images[slot]);
                 std::lock_guard<std::mutex> lock(kept->mutex);

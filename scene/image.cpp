@@ -809,7 +809,10 @@ std::string decode_jpeg(const unsigned char* data, std::size_t size, const Image
     const int format = hd.channels == 1 ? TJPF_GRAY : cmyk ? TJPF_CMYK : TJPF_RGB;
     const std::size_t out_channels = cmyk ? 4 : std::size_t(hd.channels);
     const std::size_t count = std::size_t(hd.width) * std::size_t(hd.height);
-    std::vector<std::uint8_t> px(count * out_channels);
+    // Into img's own buffer (and the room it has reserved) unless CMYK.
+    std::vector<std::uint8_t> cmyk_px;
+    std::vector<std::uint8_t>& px = cmyk ? cmyk_px : img.pixels;
+    px.resize(count * out_channels);
     if (tjDecompress2(tj.h, data, static_cast<unsigned long>(size), px.data(), hd.width,
                       int(std::size_t(hd.width) * out_channels), hd.height, format,
                       TJFLAG_ACCURATEDCT | TJFLAG_LIMITSCANS) != 0 &&
@@ -818,10 +821,7 @@ std::string decode_jpeg(const unsigned char* data, std::size_t size, const Image
     img.width = hd.width;
     img.height = hd.height;
     img.channels = hd.channels;
-    if (!cmyk) {
-        img.pixels = std::move(px);
-        return "";
-    }
+    if (!cmyk) return "";
     // Adobe's CMYK is stored inverted (255 = no ink): each colour is its
     // value scaled by K, x * k / 255 rounded.
     img.pixels.resize(count * 3);
@@ -905,7 +905,7 @@ std::string read_image_header(const unsigned char* data, std::size_t size, std::
 
 } // namespace
 
-Image decode_image(const ImageSource& src, bool srgb) {
+Image decode_image(const ImageSource& src, bool srgb, PixelCapacity capacity) {
     const std::string name = printable(!src.name.empty()   ? src.name
                                        : !src.path.empty() ? src.path
                                                            : std::string("<embedded image>"));
@@ -1001,12 +1001,14 @@ Image decode_image(const ImageSource& src, bool srgb) {
         if (srgb) expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), decode, linear);
         else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
     } else if (header.jpeg) {
+        if (capacity) reserve_huge(img.pixels, capacity(w, h, header.channels));
         const std::string why = decode_jpeg(data, bytes->size(), header, img);
         if (!why.empty()) throw LoadError(name + ": cannot decode JPEG image: " + why);
         img.srgb = srgb;
     } else if (is_png(data, bytes->size())) {
         // 8-bit PNG: the bytes as the file has them; sampling decodes them.
         std::string error;
+        if (capacity) reserve_huge(img.pixels, capacity(w, h, header.channels));
         const FastPng fast = decode_png_fast(data, bytes->size(), w, h, img, error);
         if (fast == FastPng::Failed) throw LoadError(name + ": cannot decode PNG image: " + error);
         if (fast == FastPng::NotMine) {

@@ -81,7 +81,13 @@ constexpr int kMaxStbImageSide = 1 << 15;
 // linear float and kept as is. Throws LoadError "NAME: reason" (NAME =
 // src.name, or the path) for a missing, unreadable, empty, corrupt, zero-sized
 // or oversized image.
-Image decode_image(const ImageSource& src, bool srgb);
+//
+// `capacity`, when given, says how many bytes an 8-bit image's pixel buffer
+// should have room for (a texture's mip chain after level 0, so that the
+// texture grows it in place instead of copying it): JPEG and PNG decodes
+// reserve that much before writing the pixels.
+using PixelCapacity = std::size_t (*)(int width, int height, int channels);
+Image decode_image(const ImageSource& src, bool srgb, PixelCapacity capacity = nullptr);
 
 // The width and height in an image's header, read without decoding (a file
 // only as far as its header, through scene/file_access.h), and the bytes a

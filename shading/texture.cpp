@@ -441,7 +441,7 @@ Texture Texture::from_image(Image img, Wrap s, Wrap t, ThreadPool* pool) {
         bool srgb[4] = {img.srgb, img.srgb, img.srgb, img.srgb};
         if (img.channels == 2 || img.channels == 4) srgb[img.channels - 1] = false;
         return from_unorm8(img.pixels.data(), img.channels, srgb, kSwizzle[img.channels], img.width,
-                           img.height, s, t, pool);
+                           img.height, s, t, pool, &img.pixels);
     }
     if (img.rgba.size() != count0 * 4)
         throw std::invalid_argument("Texture::from_image: rgba holds " +
@@ -481,8 +481,14 @@ struct CodeCache {
     std::uint16_t* codes() { return reinterpret_cast<std::uint16_t*>(buffer.get()); }
 };
 
+std::size_t Texture::unorm8_bytes(int w, int h, int channels) {
+    Texture tex;
+    tex.layout(w, h);
+    return tex.total_texels_ * std::size_t(channels) + kReadSlack;
+}
+
 Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const bool srgb[4], const int swizzle[4],
-                             int w, int h, Wrap s, Wrap t, ThreadPool* pool) {
+                             int w, int h, Wrap s, Wrap t, ThreadPool* pool, std::vector<std::uint8_t>* adopt) {
     Texture tex;
     tex.set_sampler(SamplerState{s, t});
     tex.channels_ = channels;
@@ -499,10 +505,17 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const boo
     // Spare bytes: the block sampler reads 4 or 8 bytes at any texel.
     const std::size_t bytes = tex.total_texels_ * C + kReadSlack;
     auto st = std::make_shared<Storage>();
-    st->bytes.reset(allocate_texels(bytes));
-    std::uint8_t* base = st->bytes.get();
+    std::uint8_t* base = nullptr;
+    if (adopt && level0 && adopt->data() == level0 && adopt->capacity() >= bytes) {
+        st->adopted = std::move(*adopt);
+        st->adopted.resize(bytes);  // no reallocation; the slack zeroed
+        base = st->adopted.data();
+    } else {
+        st->bytes.reset(allocate_texels(bytes));
+        base = st->bytes.get();
+        if (level0) std::memcpy(base, level0, std::size_t(w) * std::size_t(h) * C);
+    }
     std::memset(base + tex.total_texels_ * C, 0, kReadSlack);
-    if (level0) std::memcpy(base, level0, std::size_t(w) * std::size_t(h) * C);
     for (int l = 1; l < tex.level_count_; ++l) {
         const Level& a = tex.levels_[l - 1];
         const Level& b = tex.levels_[l];

@@ -106,8 +106,14 @@ public:
     // float; 8-bit ones as the file comment says. The rows of each level are
     // built in parallel on `pool` when given (same bytes on any thread count).
     // Throws std::invalid_argument for an empty image or a wrong data size.
+    // An 8-bit image whose pixel buffer has the capacity unorm8_bytes() asks
+    // for (decode_image's `capacity`) becomes the texture's storage in place:
+    // its level 0 is not copied.
     static Texture from_image(Image img, Wrap s = Wrap::Repeat, Wrap t = Wrap::Repeat,
                               ThreadPool* pool = nullptr);
+    // The bytes the 8-bit storage of a w x h image of `channels` takes: every
+    // level and the read slack.
+    static std::size_t unorm8_bytes(int w, int h, int channels);
 
     // Separate roughness and metalness maps (OBJ map_Pr, map_Pm: 8-bit linear,
     // same size; channel R of each is used) packed into one 2-byte texture
@@ -256,8 +262,11 @@ private:
     // Lays out the chain for a w x h level 0.
     void layout(int w, int h);
     // srgb[c]: stored channel c holds sRGB-encoded colour.
+    // With `adopt` (whose data is level0) of capacity enough, its buffer
+    // becomes the storage.
     static Texture from_unorm8(const std::uint8_t* level0, int channels, const bool srgb[4], const int swizzle[4],
-                               int w, int h, Wrap s, Wrap t, ThreadPool* pool);
+                               int w, int h, Wrap s, Wrap t, ThreadPool* pool,
+                               std::vector<std::uint8_t>* adopt = nullptr);
 
     struct FreeBytes {
         void operator()(std::uint8_t* p) const { std::free(p); }
@@ -266,6 +275,7 @@ private:
     struct Storage {
         std::vector<glm::vec4> texels;  // float storage: all levels, level 0 first, row-major
         std::unique_ptr<std::uint8_t[], FreeBytes> bytes;  // 8-bit storage, same order
+        std::vector<std::uint8_t> adopted;                  // or the decoded image's own buffer
         std::unique_ptr<CodeCache> codes;  // unorm8_codes(), or null
         Storage();
         ~Storage();

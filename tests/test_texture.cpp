@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -18,6 +19,7 @@
 
 #include "tests/scratch.h"
 
+#include "scene/encode_png.h"
 #include "scene/image.h"
 #include "scene/procedural_images.h"
 #include "shading/texture.h"
@@ -605,6 +607,47 @@ TEST_CASE("decode: JPEG through libjpeg-turbo (colour, grey, CMYK, progressive)"
             CHECK(std::abs(int(k.pixels[(std::size_t(y) * cw + x) * 3 + c]) - want) <= 2);
         }
     }
+}
+
+TEST_CASE("decode with room for the mips: the texture takes the decoded buffer, same pixels and texels") {
+    std::mt19937 rng(23u);
+    struct Case {
+        const char* name;
+        std::vector<unsigned char> bytes;
+    };
+    std::vector<Case> cases;
+    for (int channels = 1; channels <= 4; ++channels) {
+        const int w = 37 + channels * 20, h = 29 + channels;
+        std::vector<std::uint8_t> px(std::size_t(w) * std::size_t(h) * std::size_t(channels));
+        for (std::uint8_t& b : px) b = std::uint8_t(rng() & 0xFFu);
+        cases.push_back({"png", encode_png_pixels(px.data(), w, h, channels)});
+    }
+    for (int format : {TJPF_GRAY, TJPF_RGB}) {
+        const int w = 64, h = 40, C = format == TJPF_GRAY ? 1 : 3;
+        std::vector<unsigned char> px(std::size_t(w) * h * C);
+        for (std::size_t i = 0; i < px.size(); ++i) px[i] = (unsigned char)((i * 7) ^ (i >> 5));
+        cases.push_back({"jpeg", tj_compress(px, w, h, format, format == TJPF_GRAY ? TJSAMP_GRAY : TJSAMP_420, 90)});
+    }
+    for (const Case& c : cases)
+        for (bool srgb : {false, true}) {
+            ImageSource src;
+            src.bytes = c.bytes;
+            src.name = c.name;
+            const Image plain = decode_image(src, srgb);
+            Image roomy = decode_image(src, srgb, &Texture::unorm8_bytes);
+            INFO(c.name, " ", plain.width, "x", plain.height, " channels ", plain.channels, " srgb ", srgb);
+            REQUIRE(roomy.pixels == plain.pixels);
+            CHECK(roomy.pixels.capacity() >= Texture::unorm8_bytes(roomy.width, roomy.height, roomy.channels));
+            const std::uint8_t* buffer = roomy.pixels.data();
+            const Texture copied = Texture::from_image(plain);
+            const Texture adopted = Texture::from_image(std::move(roomy));
+            CHECK(adopted.unorm8_data() == buffer);  // level 0 not copied
+            CHECK(copied.unorm8_data() != plain.pixels.data());
+            REQUIRE(adopted.memory_bytes() == copied.memory_bytes());
+            CHECK(std::memcmp(adopted.unorm8_data(), copied.unorm8_data(), copied.memory_bytes()) == 0);
+            // The read slack past the last level is zero in both.
+            for (std::size_t i = 0; i < 8; ++i) CHECK(adopted.unorm8_data()[copied.memory_bytes() + i] == 0);
+        }
 }
 
 TEST_CASE("decode: randomly corrupted PNG and JPEG never crash") {
