@@ -15,6 +15,9 @@
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
+#if defined(__SSSE3__)
+#include <immintrin.h>
+#endif
 
 #include "scene/det_math.h"
 #include "raster/thread_pool.h"
@@ -158,12 +161,17 @@ struct SrgbEncoder {
             if (std::ldexp(double(value[k]), -35) != double(srgb[k])) std::abort();
             threshold_sum4[k] = k < 255 ? std::uint64_t(std::ceil(std::ldexp(threshold[k], 37))) : ~std::uint64_t(0);
         }
+        // encode_sum4's one step: every bucket [i, i + 1) / 4096 holds at most one threshold.
+        for (int k = 1; k < 255; ++k)
+            if (int(threshold[k] * 4096.0) == int(threshold[k - 1] * 4096.0)) std::abort();
     }
     // The byte of the mean of four decoded bytes, from the sum of their value[].
+    // No 1/4096 of [0, 1] holds two thresholds (the closest are 1 / (255 *
+    // 12.92) apart, near 0), so one compare finishes what start[] begins:
+    // branch-free, as the data's order would mispredict a loop's exit.
     std::uint8_t encode_sum4(std::uint64_t sum) const {
-        int b = start[sum >> 25];  // int(mean * 4096), the mean at most 1
-        while (sum >= threshold_sum4[b]) ++b;
-        return std::uint8_t(b);
+        const int b = start[sum >> 25];  // int(mean * 4096), the mean at most 1
+        return std::uint8_t(b + int(sum >= threshold_sum4[b]));
     }
     std::uint8_t encode(double linear) const {
         const double x = linear < 0.0 ? 0.0 : (linear > 1.0 ? 1.0 : linear);
@@ -178,6 +186,71 @@ const SrgbEncoder& srgb_encoder() {
     return e;
 }
 
+#if defined(__SSSE3__)
+// Byte shuffles for 4 output texels of a linear C-channel 2x2 row: from the
+// 8C input bytes (the first 16 in one register, the rest in another), byte
+// k < 4C of `first` is input byte 2C (k / C) + k % C (the left texel's
+// channel), of `second` the one C bytes on (the right texel's).
+struct Pick2x2 {
+    alignas(16) std::int8_t first_lo[16], first_hi[16], second_lo[16], second_hi[16];
+};
+constexpr Pick2x2 pick_2x2(int C) {
+    Pick2x2 p{};
+    for (int k = 0; k < 16; ++k) {
+        const int a = k < 4 * C ? 2 * C * (k / C) + k % C : -1, b = a < 0 ? -1 : a + C;
+        p.first_lo[k] = std::int8_t(a >= 0 && a < 16 ? a : -1);
+        p.first_hi[k] = std::int8_t(a >= 16 ? a - 16 : -1);
+        p.second_lo[k] = std::int8_t(b >= 0 && b < 16 ? b : -1);
+        p.second_hi[k] = std::int8_t(b >= 16 ? b - 16 : -1);
+    }
+    return p;
+}
+template <int C> struct Pick2x2Of {
+    static constexpr Pick2x2 pick = pick_2x2(C);
+};
+
+// The 8C bytes of 4 texel pairs of a row (lo: the first 16), never read past them.
+template <int C> inline void load_2x2_block(const std::uint8_t* p, __m128i& lo, __m128i& hi) {
+    lo = C == 1 ? _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))
+                : _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+    hi = C == 3   ? _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + 16))
+         : C == 4 ? _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16))
+                  : _mm_setzero_si128();
+}
+
+// Output texels [0, 4 * (dw / 4)) of a linear row, as the scalar loop below
+// gives them: (a + b + c + d + 2) >> 2 per channel, in 16-bit lanes.
+template <int C> int downsample_2x2_linear_sse(const std::uint8_t* r0, const std::uint8_t* r1, std::uint8_t* out, int dw) {
+    const Pick2x2& pk = Pick2x2Of<C>::pick;
+    const __m128i fl = _mm_load_si128(reinterpret_cast<const __m128i*>(pk.first_lo));
+    const __m128i fh = _mm_load_si128(reinterpret_cast<const __m128i*>(pk.first_hi));
+    const __m128i sl = _mm_load_si128(reinterpret_cast<const __m128i*>(pk.second_lo));
+    const __m128i sh = _mm_load_si128(reinterpret_cast<const __m128i*>(pk.second_hi));
+    const __m128i zero = _mm_setzero_si128(), two = _mm_set1_epi16(2);
+    int i = 0;
+    for (; i + 4 <= dw; i += 4) {
+        __m128i a0, b0, a1, b1;
+        load_2x2_block<C>(r0 + std::size_t(i) * 2 * C, a0, b0);
+        load_2x2_block<C>(r1 + std::size_t(i) * 2 * C, a1, b1);
+        const __m128i f0 = _mm_or_si128(_mm_shuffle_epi8(a0, fl), _mm_shuffle_epi8(b0, fh));
+        const __m128i s0 = _mm_or_si128(_mm_shuffle_epi8(a0, sl), _mm_shuffle_epi8(b0, sh));
+        const __m128i f1 = _mm_or_si128(_mm_shuffle_epi8(a1, fl), _mm_shuffle_epi8(b1, fh));
+        const __m128i s1 = _mm_or_si128(_mm_shuffle_epi8(a1, sl), _mm_shuffle_epi8(b1, sh));
+        auto half = [&](auto unpack) {
+            const __m128i top = _mm_add_epi16(unpack(f0, zero), unpack(s0, zero));
+            const __m128i bottom = _mm_add_epi16(unpack(f1, zero), unpack(s1, zero));
+            return _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(top, bottom), two), 2);
+        };
+        const __m128i lo = half([](__m128i x, __m128i z) { return _mm_unpacklo_epi8(x, z); });
+        const __m128i hi = half([](__m128i x, __m128i z) { return _mm_unpackhi_epi8(x, z); });
+        alignas(16) std::uint8_t bytes[16];
+        _mm_store_si128(reinterpret_cast<__m128i*>(bytes), _mm_packus_epi16(lo, hi));
+        std::memcpy(out + std::size_t(i) * C, bytes, 4 * C);  // the row's own bytes only
+    }
+    return i;
+}
+#endif
+
 // One output row of the 2x2 case, the channel layout fixed at compile time:
 // C channels, the colour ones sRGB when Srgb (alpha, channel 1 of 2 or 3 of
 // 4, never). Sums of four table values are exact in double (each value is a
@@ -187,7 +260,16 @@ void downsample_2x2_row(const std::uint8_t* r0, const std::uint8_t* r1, std::uin
     const SrgbEncoder& enc = srgb_encoder();
     const std::uint64_t* value = enc.value;
     constexpr int kAlpha = C == 2 ? 1 : (C == 4 ? 3 : -1);
-    for (int i = 0; i < dw; ++i, r0 += 2 * C, r1 += 2 * C, out += C) {
+    int i = 0;
+#if defined(__SSSE3__)
+    if constexpr (!Srgb) {
+        i = downsample_2x2_linear_sse<C>(r0, r1, out, dw);
+        r0 += std::size_t(i) * 2 * C;
+        r1 += std::size_t(i) * 2 * C;
+        out += std::size_t(i) * C;
+    }
+#endif
+    for (; i < dw; ++i, r0 += 2 * C, r1 += 2 * C, out += C) {
         for (int c = 0; c < C; ++c) {
             if (Srgb && c != kAlpha) {
                 out[c] = enc.encode_sum4(value[r0[c]] + value[r0[C + c]] + value[r1[c]] + value[r1[C + c]]);
