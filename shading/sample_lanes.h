@@ -359,6 +359,31 @@ template <class Isa, int C>
     pair[3] = _mm256_unpackhi_epi64(t2, t3);
 }
 
+// code_pair_rows for linear channels of the 8-bit bytes themselves: a
+// lane's 2C bytes are one 8-byte load at its x0, the shuffle puts channel
+// c's two bytes in the low bytes of dword c's words, and times 128 they are
+// the codes (channel_codes()).
+template <class Isa, int C>
+[[gnu::always_inline]] inline void byte_pair_rows(const std::uint8_t* base, const std::int32_t* ix, __m256i pair[4]) {
+    auto at = [&](int l) __attribute__((always_inline)) {
+        return _mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + std::size_t(ix[l]) * C));
+    };
+    const __m256i pick = C == 4 ? _mm256_setr_epi8(0, -1, 4, -1, 1, -1, 5, -1, 2, -1, 6, -1, 3, -1, 7, -1,
+                                                   0, -1, 4, -1, 1, -1, 5, -1, 2, -1, 6, -1, 3, -1, 7, -1)
+                                : _mm256_setr_epi8(0, -1, 3, -1, 1, -1, 4, -1, 2, -1, 5, -1, -1, -1, -1, -1,
+                                                   0, -1, 3, -1, 1, -1, 4, -1, 2, -1, 5, -1, -1, -1, -1, -1);
+    __m256i v[4];
+    for (int k = 0; k < 4; ++k)
+        v[k] = _mm256_slli_epi32(
+            _mm256_shuffle_epi8(_mm256_inserti128_si256(_mm256_castsi128_si256(at(k)), at(k + 4), 1), pick), 7);
+    const __m256i t0 = _mm256_unpacklo_epi32(v[0], v[1]), t1 = _mm256_unpacklo_epi32(v[2], v[3]);
+    const __m256i t2 = _mm256_unpackhi_epi32(v[0], v[1]), t3 = _mm256_unpackhi_epi32(v[2], v[3]);
+    pair[0] = _mm256_unpacklo_epi64(t0, t1);
+    pair[1] = _mm256_unpackhi_epi64(t0, t1);
+    pair[2] = _mm256_unpacklo_epi64(t2, t3);
+    pair[3] = _mm256_unpackhi_epi64(t2, t3);
+}
+
 #if defined(__AVX512VBMI__)
 // The sRGB code table (texture_detail::srgb_code_table()) as the low and the
 // high bytes of its 256 codes: a byte permute looks up 128 entries at once.
@@ -528,6 +553,14 @@ template <class V, int C, class Isa>
             I top[4], bottom[4];
             code_pair_rows<Isa, C>(codes, idx[0] + l0, top);
             code_pair_rows<Isa, C>(codes, idx[2] + l0, bottom);
+            for (int c = 0; c < C; ++c)
+                if ((need >> c) & 1u) result[c] = bilerp_pairs<V>(top[c], bottom[c], wx, wy);
+            return;
+        }
+        if (pairs && !needs_srgb) {
+            I top[4], bottom[4];
+            byte_pair_rows<Isa, C>(base, idx[0] + l0, top);
+            byte_pair_rows<Isa, C>(base, idx[2] + l0, bottom);
             for (int c = 0; c < C; ++c)
                 if ((need >> c) & 1u) result[c] = bilerp_pairs<V>(top[c], bottom[c], wx, wy);
             return;
