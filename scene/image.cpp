@@ -30,7 +30,9 @@
 #include <stb_image.h>
 #include <turbojpeg.h>
 #include <webp/decode.h>
+#ifdef __linux__
 #include <sys/mman.h>
+#endif
 #include <unistd.h>
 
 #include "scene/det_math.h"
@@ -343,9 +345,10 @@ bool png_zlib_header_ok(unsigned char cmf, unsigned char flg) {
 bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h, int channels, Image& img) {
     const std::size_t stride = std::size_t(w) * std::size_t(channels);
     const std::size_t raw_size = (stride + 1) * std::size_t(h);
-    // The image's filtered rows are held whole next to its pixels: beyond
-    // 128 MiB (a 5,792-texel RGBA square) the zlib path's 256 KiB at a time
-    // keeps a huge texture's decode within what the memory plan counted.
+    // The image's filtered rows are held whole (in its pixels' buffer, with
+    // the compressed data beside them): beyond 128 MiB (a 5,792-texel RGBA
+    // square) the zlib path's 256 KiB at a time keeps a huge texture's
+    // decode within what the memory plan counted.
     if (raw_size > (std::size_t(128) << 20)) return false;
     std::vector<unsigned char> compressed;
     for (std::size_t pos = 8; pos + 12 <= size;) {

@@ -220,7 +220,8 @@ template <int C> inline void load_2x2_block(const std::uint8_t* p, __m128i& lo, 
 
 // Output texels [0, 4 * (dw / 4)) of a linear row, as the scalar loop below
 // gives them: (a + b + c + d + 2) >> 2 per channel, in 16-bit lanes.
-template <int C> int downsample_2x2_linear_sse(const std::uint8_t* r0, const std::uint8_t* r1, std::uint8_t* out, int dw) {
+template <int C>
+int downsample_2x2_linear_sse(const std::uint8_t* r0, const std::uint8_t* r1, std::uint8_t* out, int dw) {
     const Pick2x2& pk = Pick2x2Of<C>::pick;
     const __m128i fl = _mm_load_si128(reinterpret_cast<const __m128i*>(pk.first_lo));
     const __m128i fh = _mm_load_si128(reinterpret_cast<const __m128i*>(pk.first_hi));
