@@ -43,8 +43,7 @@ constexpr float kBevel = 0.10f;      // width of the rounded brick edge, in H
 enum class Zone { Grout, Bevel, Face };
 
 struct BrickPoint {
-    std::uint32_t id = 0;  // hash of the (wrapped) brick coordinates
-    int cell = 0;          // the wrapped brick coordinates, col + row * kBrickCols
+    int cell = 0;  // the wrapped brick coordinates, col + row * kBrickCols (look_of)
     Zone zone = Zone::Face;
     float t = 0.0f;        // position across the zone, 0 at its inner (grout-side) edge
     glm::vec2 inward{0.0f};  // uv direction in which the distance to the brick edge grows
@@ -61,7 +60,6 @@ BrickPoint brick_at(glm::vec2 uv) {
     BrickPoint p;
     const int wcol = ((icol % kBrickCols) + kBrickCols) % kBrickCols;
     const int wrow = ((irow % kBrickRows) + kBrickRows) % kBrickRows;
-    p.id = hash3(wcol, wrow, 17U);
     p.cell = wcol + wrow * kBrickCols;
     // Distances to the nearest vertical and horizontal brick edges, in H.
     const float dx = std::min(fx, 1.0f - fx) * 2.0f;
