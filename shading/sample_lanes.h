@@ -127,21 +127,39 @@ struct LevelLanes {
     }
 };
 
+// wrap_index<W>(i, n) and wrap_index<W>(i + 1, n) for i = floor(r n - 0.5)
+// of a reduced coordinate r = reduce<W>(c). For Repeat and ClampToEdge r is
+// in [0, 1], so i is in [-1, n - 1] and each index meets one side only.
+template <Wrap W>
+[[gnu::always_inline]] inline void wrap_pair(int i, int n, int& a, int& b) {
+    if constexpr (W == Wrap::Repeat) {
+        a = i < 0 ? i + n : i;
+        b = i + 1 >= n ? i + 1 - n : i + 1;
+    } else if constexpr (W == Wrap::ClampToEdge) {
+        a = i < 0 ? 0 : i;
+        b = i + 1 >= n ? n - 1 : i + 1;
+    } else {
+        a = texture_detail::wrap_index<W>(i, n);
+        b = texture_detail::wrap_index<W>(i + 1, n);
+    }
+}
+
 // Texture::bilinear_reduced() up to the texel indices, for the first N lanes.
 template <int N, Wrap S, Wrap T, class Isa = IsaDefault>
 inline void bilinear_indices(const float* __restrict ur, const float* __restrict vr,
                              const LevelLanes& __restrict L, std::int32_t (*__restrict idx)[kMaxN],
                              float* __restrict tx, float* __restrict ty) {
-    using texture_detail::wrap_index;
     for (int l = 0; l < N; ++l) {
         const float x = ur[l] * L.fw[l] - 0.5f, y = vr[l] * L.fh[l] - 0.5f;
         const float fx = std::floor(x), fy = std::floor(y);
         tx[l] = x - fx;
         ty[l] = y - fy;
         const int x0 = int(fx), y0 = int(fy), w = L.w[l], h = L.h[l];
-        const int xa = wrap_index<S>(x0, w), xb = wrap_index<S>(x0 + 1, w);
-        const int row_a = L.offset[l] + wrap_index<T>(y0, h) * w;
-        const int row_b = L.offset[l] + wrap_index<T>(y0 + 1, h) * w;
+        int xa, xb, ya, yb;
+        wrap_pair<S>(x0, w, xa, xb);
+        wrap_pair<T>(y0, h, ya, yb);
+        const int row_a = L.offset[l] + ya * w;
+        const int row_b = L.offset[l] + yb * w;
         idx[0][l] = row_a + xa;
         idx[1][l] = row_a + xb;
         idx[2][l] = row_b + xa;
@@ -531,10 +549,11 @@ inline typename V::I bilerp_pairs(typename V::I top, typename V::I bottom, typen
 }
 
 // Bilinear filter of every needed stored channel of one level for lanes
-// [l0, l0 + W): Texture::fix_bilinear() per lane.
+// [l0, l0 + W): Texture::fix_bilinear() per lane. needs_srgb: a channel in
+// `need` is sRGB-encoded (srgb_codes[c] set).
 template <class V, int C, class Isa>
 [[gnu::always_inline]] inline void bilinear_unorm8(const Texture& tex, const std::uint16_t* codes, const std::uint16_t* const* srgb_codes, unsigned need,
-                                                   const std::int32_t (*idx)[kMaxN], const float* tx_lanes,
+                                                   bool needs_srgb, const std::int32_t (*idx)[kMaxN], const float* tx_lanes,
                                                    const float* ty_lanes, int l0, typename V::I* result) {
     using I = typename V::I;
     const std::uint8_t* base = tex.unorm8_data();
@@ -546,8 +565,6 @@ template <class V, int C, class Isa>
     const bool pairs = V::all_i(V::and_i(V::cmpeq_i(ib, V::add_i(ia, one)), V::cmpeq_i(id, V::add_i(ic, one))));
     const I wx = weight_pairs<V>(weight8<V>(V::load_f(tx_lanes + l0)));
     const I wy = weight_pairs<V>(weight8<V>(V::load_f(ty_lanes + l0)));
-    bool needs_srgb = false;  // a needed channel is sRGB-encoded
-    for (int c = 0; c < C; ++c) needs_srgb |= ((need >> c) & 1u) && srgb_codes[c];
     if constexpr (std::is_same_v<V, Simd<8>> && (C == 3 || C == 4)) {
         if (pairs && codes) {
             I top[4], bottom[4];
@@ -663,24 +680,36 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
     const std::uint16_t* srgb_codes[4] = {nullptr, nullptr, nullptr, nullptr};
     for (int c = 0; c < C; ++c) srgb_codes[c] = tex.srgb(c) ? tex.code_table(c) : nullptr;
     const std::uint16_t* codes = W == 8 && C >= 3 ? tex.unorm8_codes(at.levels) : nullptr;
-    float* dst[4] = {out.r, out.g, out.b, out.a};
+    // What every group of W lanes does alike, worked out once: the stored
+    // channels needed, and each written output's destination and source
+    // channel (-1: the constant 1).
+    float* const all_dst[4] = {out.r, out.g, out.b, out.a};
+    float* dst[4];
+    int src[4];
+    int outputs = 0;
     unsigned need = 0;
-    for (int k = 0; k < 4; ++k)
-        if (((components >> k) & 1u) && tex.swizzle(k) != Texture::kOne) need |= 1u << tex.swizzle(k);
+    for (int k = 0; k < 4; ++k) {
+        if (!((components >> k) & 1u)) continue;
+        const int sw = tex.swizzle(k);
+        dst[outputs] = all_dst[k];
+        src[outputs++] = sw == Texture::kOne ? -1 : sw;
+        if (sw != Texture::kOne) need |= 1u << sw;
+    }
+    bool needs_srgb = false;  // a needed channel is sRGB-encoded
+    for (int c = 0; c < C; ++c) needs_srgb |= ((need >> c) & 1u) && srgb_codes[c];
     for (int l0 = 0; l0 < N; l0 += W) {
         const unsigned live = (at.live >> l0) & ((1u << W) - 1u);
         if (!live) {
-            for (int k = 0; k < 4; ++k)
-                if ((components >> k) & 1u) V::store_f(dst[k] + l0, V::zero_f());
+            for (int k = 0; k < outputs; ++k) V::store_f(dst[k] + l0, V::zero_f());
             continue;
         }
         const I izero = V::set1_i(0);
         I res[4] = {izero, izero, izero, izero};
-        bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, at.ia, at.txa, at.tya, l0, res);
+        bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, needs_srgb, at.ia, at.txa, at.tya, l0, res);
         const unsigned blend = (at.blend >> l0) & ((1u << W) - 1u);
         if (blend) {
             I resb[4] = {izero, izero, izero, izero};
-            bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, at.ib, at.txb, at.tyb, l0, resb);
+            bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, needs_srgb, at.ib, at.txb, at.tyb, l0, resb);
             const I wt = weight_pairs<V>(weight8<V>(V::load_f(at.t + l0)));
             const I mask = V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits());
             for (int c = 0; c < C; ++c)
@@ -693,10 +722,8 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
         F value[4] = {zero, zero, zero, zero};
         for (int c = 0; c < C; ++c)
             if ((need >> c) & 1u) value[c] = V::div(V::cvt(res[c]), full);  // Texture::fix_value()
-        for (int k = 0; k < 4; ++k) {
-            if (!((components >> k) & 1u)) continue;
-            const int sw = tex.swizzle(k);
-            const F v = sw == Texture::kOne ? V::set1_f(1.0f) : value[sw];
+        for (int k = 0; k < outputs; ++k) {
+            const F v = src[k] < 0 ? V::set1_f(1.0f) : value[src[k]];
             V::store_f(dst[k] + l0, V::select(live_mask, v, zero));
         }
     }
@@ -811,7 +838,7 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
     // 16-bit codes the fetch has filled (Texture::unorm8_codes()).
     {
         const int q_live = live_quads ? __builtin_ctz(live_quads) : 0;
-        for (int q = 0; q < kMaxQuadSlots; ++q)
+        for (int q = 0; q < (unpacked ? 4 : kMaxQuadSlots); ++q)
             if (!((live_quads >> q) & 1u)) la[q] = la[q_live];
     }
     out.live = live;

@@ -53,8 +53,8 @@ Texture random_texture(std::mt19937& rng, int w, int h, Wrap s, Wrap t) {
     return Texture::from_image(std::move(img), s, t);
 }
 
-// A coordinate: mostly ordinary, sometimes on a texel centre or edge, far
-// away, or not a number at all.
+// A coordinate: mostly ordinary, sometimes on a texel centre or edge, at
+// the ends of [0, 1], far away, or not a number at all.
 float random_coord(std::mt19937& rng, int size) {
     std::uniform_real_distribution<float> uni(-3.0f, 3.0f);
     std::uniform_int_distribution<int> pick(0, 19), texel(-2 * size, 2 * size);
@@ -66,6 +66,8 @@ float random_coord(std::mt19937& rng, int size) {
     case 4: return float(texel(rng)) / float(size);                  // texel edge
     case 5: return (float(texel(rng)) + 0.5f) / float(size);         // texel centre
     case 6: return float(texel(rng) / size);                         // integer
+    case 7: return -1e-9f;  // Repeat folds it to exactly 1: the last texel and the first
+    case 8: return 1.0f;
     default: return uni(rng);
     }
 }
