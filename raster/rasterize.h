@@ -345,6 +345,9 @@ struct BlockSamples {
     std::uint32_t cover[kMaxSamples];
     std::uint32_t pass[kMaxSamples];
     std::uint32_t any_cover = 0, any_pass = 0;
+    // No edge crosses the block's sample box, which holds its pixel centres:
+    // every centre is inside too (no lane moves to a centroid).
+    bool inside = false;
     alignas(64) float z[kMaxSamples][kBlockLanes];
     alignas(64) float b0[kBlockLanes], b1[kBlockLanes], b2[kBlockLanes];
 };
@@ -422,6 +425,8 @@ inline void block_coverage(const TriangleSetup& t, const TileContext& c, const T
     const int S = samples_of<MS>(c);
     const std::uint32_t scissor = scissor_mask(bx, by, c.width, c.height);
     bs.any_cover = 0;
+    const SampleExtent& x = c.extent;
+    bs.inside = !partial && x.lo_x <= 0 && x.hi_x >= 0 && x.lo_y <= 0 && x.hi_y >= 0;
     if (!partial) {
         for (int s = 0; s < S; ++s) bs.cover[s] = scissor;
         bs.any_cover = scissor;

@@ -162,10 +162,12 @@ void interpolate_centroids(const TriangleSetup& t, const TriangleVaryings<NV>& p
 // several samples, the live lanes (`lanes`) whose centre is outside the
 // triangle move to the centroid of their covered samples.
 // `centre`: the lanes' centre barycentrics and depths when the caller has
-// them (one sample: test_depth's), else null.
+// them (one sample: test_depth's), else null. `inside`: every centre is
+// known to be inside (BlockSamples::inside), so none moves.
 template <bool MS, int NV>
 void interpolate_block(const TriangleSetup& t, const TriangleVaryings<NV>& p, const SamplePattern& sp, int bx,
-                       int by, std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in) {
+                       int by, std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in,
+                       bool inside = false) {
     alignas(64) float cb0[kBlockLanes], cb1[kBlockLanes], cb2[kBlockLanes];
     const float *b0 = cb0, *b1 = cb1, *b2 = cb2;
     if (centre) {
@@ -196,7 +198,9 @@ void interpolate_block(const TriangleSetup& t, const TriangleVaryings<NV>& p, co
         }
     }
     in.centroid_mask = 0;
-    if constexpr (MS) interpolate_centroids(t, p, sp, bx, by, lanes, in);
+    if constexpr (MS) {
+        if (!inside) interpolate_centroids(t, p, sp, bx, by, lanes, in);
+    }
 }
 
 // Colour of the lanes in `mask` (one sample plane, `row` pixels wide) from
@@ -279,8 +283,8 @@ inline void write_color(float* color, std::size_t row, std::uint32_t mask, const
 // A block's fragment inputs: its lanes interpolated, its place, mask and triangle.
 template <bool MS, int NV>
 inline void fill_block(const TriangleSetup& t, const TriangleVaryings<NV>& pv, const TileContext& c, int bx, int by,
-                       std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in) {
-    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, lanes, centre, in);
+                       std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in, bool inside = false) {
+    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, lanes, centre, in, inside);
     in.x = bx;
     in.y = by;
     in.mask = lanes;
@@ -306,7 +310,7 @@ void shade_in_order(const Program& program, const DrawState& st, const TriangleS
     if (!bs.any_pass) return;
 
     FragmentBlock<NV> in;
-    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, MS ? nullptr : &bs, in);
+    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, MS ? nullptr : &bs, in, bs.inside);
     FragmentOut out;
     out.kill = 0;
     program.fragment(in, out);
@@ -455,7 +459,7 @@ template <bool MS, class Program>
     if (popcount16(bs.any_pass) > kBatchBlockLanes && !(batch.count && batch.fits(bs.any_pass))) {
         if (batch.holds_block(bx, by)) flush_batch<MS>(program, batch, c, st.blend, true);
         FragmentBlock<NV> in;
-        fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, in);
+        fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, in, bs.inside);
         FragmentOut out;
         out.kill = 0;
         program.fragment(in, out);
@@ -464,7 +468,7 @@ template <bool MS, class Program>
     }
     if (!batch.fits(bs.any_pass)) flush_batch<MS>(program, batch, c, st.blend, true);
     const int i = batch.add(bs.any_pass);
-    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, batch.in[i]);
+    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, batch.in[i], bs.inside);
     for (int s = 0; s < samples_of<MS>(c); ++s) batch.write[i][s] = bs.pass[s];
 }
 
