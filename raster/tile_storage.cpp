@@ -34,10 +34,11 @@ void clear_samples(float* color, float* depth, int size, int samples, const floa
     const std::size_t n = std::size_t(size) * std::size_t(size) * std::size_t(samples);
     std::fill(depth, depth + n, z);
     if (!color) return;
-    // Eight floats (two pixels) at a time; n is even (size is a multiple of 4).
-    float pair[8];
-    for (int i = 0; i < 8; ++i) pair[i] = rgba[i & 3];
-    for (std::size_t i = 0; i < n * 4; i += 8) std::memcpy(color + i, pair, sizeof pair);
+    // Eight floats (two pixels) at a time, held in one register; n is even
+    // (size is a multiple of 4).
+    typedef float Pair __attribute__((vector_size(32)));
+    const Pair pair = {rgba[0], rgba[1], rgba[2], rgba[3], rgba[0], rgba[1], rgba[2], rgba[3]};
+    for (std::size_t i = 0; i < n * 4; i += 8) std::memcpy(color + i, &pair, sizeof pair);
 }
 
 void load_samples(const Framebuffer& fb, const TileRect& r, float* color, float* depth, int size, int samples) {
@@ -60,6 +61,15 @@ namespace {
 // Eight floats (two pixels' RGBA, or eight depths) at a time.
 typedef float Floats8 __attribute__((vector_size(32)));
 
+// One unaligned 32-byte load. Copying into an element of an array of
+// Floats8 inside a loop compiled to two 16-byte stores read back as one
+// 32-byte load, which stalls on store forwarding.
+inline Floats8 load8(const float* p) {
+    Floats8 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+
 template <int S>
 inline void resolve_row(const float* color, const float* depth, std::size_t plane, int width, float* out_color,
                         float* out_depth) {
@@ -67,11 +77,10 @@ inline void resolve_row(const float* color, const float* depth, std::size_t plan
     int x = 0;
     if (!out_depth) x = width;  // colour only
     for (; x + 8 <= width; x += 8) {
-        Floats8 z;
-        std::memcpy(&z, depth + x, sizeof z);
+        Floats8 z = load8(depth + x);
+#pragma GCC unroll 8
         for (int s = 1; s < S; ++s) {
-            Floats8 v;
-            std::memcpy(&v, depth + x + s * plane, sizeof v);
+            const Floats8 v = load8(depth + x + s * plane);
             z = v < z ? v : z;  // std::min(z, v)
         }
         std::memcpy(out_depth + x, &z, sizeof z);
@@ -86,7 +95,8 @@ inline void resolve_row(const float* color, const float* depth, std::size_t plan
     std::size_t i = 0;
     for (; i + 8 <= n; i += 8) {
         Floats8 v[S];
-        for (int s = 0; s < S; ++s) std::memcpy(&v[s], color + i + s * cplane, sizeof v[s]);
+#pragma GCC unroll 8
+        for (int s = 0; s < S; ++s) v[s] = load8(color + i + s * cplane);
         for (int k = S; k > 1; k /= 2)
             for (int j = 0; j < k / 2; ++j) v[j] = v[2 * j] + v[2 * j + 1];
         v[0] = v[0] * kInv;
