@@ -333,7 +333,7 @@ inline void gather_texel_pairs(const std::uint8_t* base, const std::int32_t* ix,
                                typename V::I& right) {
     if constexpr (C <= 2) {
         left = V::template gather_i<C>(base, ix);
-        right = V::srlv_i(left, V::set1_i(8 * C));
+        right = V::srlv_i(left, V::template splat_i<8 * C>());
     } else {
         V::template gather_q<C, 8 * C>(base, ix, left, right);
     }
@@ -344,10 +344,10 @@ inline void gather_texel_pairs(const std::uint8_t* base, const std::int32_t* ix,
 // table has spare entries).
 template <class V>
 inline typename V::I channel_codes(typename V::I words, int c, const std::uint16_t* srgb_codes) {
-    const typename V::I byte = V::and_i(V::srlv_i(words, V::set1_i(8 * c)), V::set1_i(0xFF));
+    const typename V::I byte = V::and_i(V::srlv_i(words, V::set1_i(8 * c)), V::template splat_i<0xFF>());
     if (!srgb_codes) return V::template slli_i<7>(byte);
     return V::and_i(V::template gather_i<2>(reinterpret_cast<const std::uint8_t*>(srgb_codes), byte),
-                    V::set1_i(0xFFFF));
+                    V::template splat_i<0xFFFF>());
 }
 
 // Both taps' codes of one row for 8 lanes of a 3- or 4-channel texture
@@ -529,7 +529,7 @@ template <class V> inline typename V::I weight8(typename V::F t) {
     return V::cvtt(V::add(V::mul(t, V::set1_f(256.0f)), V::set1_f(0.5f)));
 }
 template <class V> inline typename V::I weight_pairs(typename V::I w) {
-    return V::or_i(V::sub_i(V::set1_i(256), w), V::template slli_i<16>(w));
+    return V::or_i(V::sub_i(V::template splat_i<256>(), w), V::template slli_i<16>(w));
 }
 // a | b << 16: the 16-bit pair a lerp multiplies.
 template <class V> inline typename V::I code_pair(typename V::I a, typename V::I b) {
@@ -539,7 +539,7 @@ template <class V> inline typename V::I lerp8(typename V::I a, typename V::I b, 
     return V::madd_i(code_pair<V>(a, b), pairs);
 }
 template <class V> inline typename V::I narrow8(typename V::I x) {
-    return V::template srli_i<8>(V::add_i(x, V::set1_i(128)));
+    return V::template srli_i<8>(V::add_i(x, V::template splat_i<128>()));
 }
 // The bilinear filter of a row pair's codes, each row as (x0) | (x1) << 16:
 // the x-lerps narrowed, then the y-lerp (Texture::fix_bilinear()).
@@ -561,7 +561,7 @@ template <class V, int C, class Isa>
     const I ic = V::load_i(idx[2] + l0), id = V::load_i(idx[3] + l0);
     // Unless a lane's footprint wraps or clamps at a row's end, its right taps
     // follow its left ones in memory: half the gathered elements.
-    const I one = V::set1_i(1);
+    const I one = V::template splat_i<1>();
     const bool pairs = V::all_i(V::and_i(V::cmpeq_i(ib, V::add_i(ia, one)), V::cmpeq_i(id, V::add_i(ic, one))));
     const I wx = weight_pairs<V>(weight8<V>(V::load_f(tx_lanes + l0)));
     const I wy = weight_pairs<V>(weight8<V>(V::load_f(ty_lanes + l0)));
@@ -687,46 +687,53 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
     float* dst[4];
     int src[4];
     int outputs = 0;
-    unsigned need = 0;
+    unsigned needed = 0;
     for (int k = 0; k < 4; ++k) {
         if (!((components >> k) & 1u)) continue;
         const int sw = tex.swizzle(k);
         dst[outputs] = all_dst[k];
         src[outputs++] = sw == Texture::kOne ? -1 : sw;
-        if (sw != Texture::kOne) need |= 1u << sw;
+        if (sw != Texture::kOne) needed |= 1u << sw;
     }
     bool needs_srgb = false;  // a needed channel is sRGB-encoded
-    for (int c = 0; c < C; ++c) needs_srgb |= ((need >> c) & 1u) && srgb_codes[c];
-    for (int l0 = 0; l0 < N; l0 += W) {
-        const unsigned live = (at.live >> l0) & ((1u << W) - 1u);
-        if (!live) {
-            for (int k = 0; k < outputs; ++k) V::store_f(dst[k] + l0, V::zero_f());
-            continue;
-        }
-        const I izero = V::set1_i(0);
-        I res[4] = {izero, izero, izero, izero};
-        bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, needs_srgb, at.ia, at.txa, at.tya, l0, res);
-        const unsigned blend = (at.blend >> l0) & ((1u << W) - 1u);
-        if (blend) {
-            I resb[4] = {izero, izero, izero, izero};
-            bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, needs_srgb, at.ib, at.txb, at.tyb, l0, resb);
-            const I wt = weight_pairs<V>(weight8<V>(V::load_f(at.t + l0)));
-            const I mask = V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits());
+    for (int c = 0; c < C; ++c) needs_srgb |= ((needed >> c) & 1u) && srgb_codes[c];
+    // The loop over groups, inlined twice: with every stored channel needed
+    // (the usual case) `need` is a constant there and its tests fold away.
+    auto groups = [&](const unsigned need) __attribute__((always_inline)) {
+        for (int l0 = 0; l0 < N; l0 += W) {
+            const unsigned live = (at.live >> l0) & ((1u << W) - 1u);
+            if (!live) {
+                for (int k = 0; k < outputs; ++k) V::store_f(dst[k] + l0, V::zero_f());
+                continue;
+            }
+            const I izero = V::set1_i(0);
+            I res[4] = {izero, izero, izero, izero};
+            bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, needs_srgb, at.ia, at.txa, at.tya, l0, res);
+            const unsigned blend = (at.blend >> l0) & ((1u << W) - 1u);
+            if (blend) {
+                I resb[4] = {izero, izero, izero, izero};
+                bilinear_unorm8<V, C, Isa>(tex, codes, srgb_codes, need, needs_srgb, at.ib, at.txb, at.tyb, l0, resb);
+                const I wt = weight_pairs<V>(weight8<V>(V::load_f(at.t + l0)));
+                const I mask = V::cmpeq_i(V::and_i(V::set1_i(int(blend)), V::lane_bits()), V::lane_bits());
+                for (int c = 0; c < C; ++c)
+                    if ((need >> c) & 1u)
+                        res[c] = V::select_i(mask, lerp8<V>(narrow8<V>(res[c]), narrow8<V>(resb[c]), wt), res[c]);
+            }
+            const F live_mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(live)), V::lane_bits()), V::lane_bits()));
+            const F zero = V::zero_f();
+            const F full = V::set1_f(texture_detail::kFixFullF);
+            F value[4] = {zero, zero, zero, zero};
             for (int c = 0; c < C; ++c)
-                if ((need >> c) & 1u)
-                    res[c] = V::select_i(mask, lerp8<V>(narrow8<V>(res[c]), narrow8<V>(resb[c]), wt), res[c]);
+                if ((need >> c) & 1u) value[c] = V::div(V::cvt(res[c]), full);  // Texture::fix_value()
+            for (int k = 0; k < outputs; ++k) {
+                const F v = src[k] < 0 ? V::set1_f(1.0f) : value[src[k]];
+                V::store_f(dst[k] + l0, V::select(live_mask, v, zero));
+            }
         }
-        const F live_mask = V::as_f(V::cmpeq_i(V::and_i(V::set1_i(int(live)), V::lane_bits()), V::lane_bits()));
-        const F zero = V::zero_f();
-        const F full = V::set1_f(texture_detail::kFixFullF);
-        F value[4] = {zero, zero, zero, zero};
-        for (int c = 0; c < C; ++c)
-            if ((need >> c) & 1u) value[c] = V::div(V::cvt(res[c]), full);  // Texture::fix_value()
-        for (int k = 0; k < outputs; ++k) {
-            const F v = src[k] < 0 ? V::set1_f(1.0f) : value[src[k]];
-            V::store_f(dst[k] + l0, V::select(live_mask, v, zero));
-        }
-    }
+    };
+    constexpr unsigned kAll = (1u << C) - 1u;
+    if (needed == kAll) groups(kAll);
+    else groups(needed);
 }
 
 // Blocks with at most this many live lanes read them one by one.

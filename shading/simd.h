@@ -42,6 +42,11 @@ template <class Vec, int Scale, std::size_t... L>
     return Vec{load_element<long long, Scale>(base, ix[L])...};
 }
 
+// An integer in memory for Simd<8>::splat_i().
+template <int K> struct Splat {
+    static constexpr std::int32_t value = K;
+};
+
 } // namespace simd_detail
 
 // W lanes per instruction: 8 (ymm) or 4 (xmm).
@@ -54,6 +59,18 @@ template <> struct Simd<8> {
     static F load_f(const float* p) { return _mm256_load_ps(p); }
     static void store_f(float* p, F v) { _mm256_store_ps(p, v); }
     static I set1_i(int v) { return _mm256_set1_epi32(v); }
+    // set1_i(K) for a constant K. GCC 12 builds an integer splat in a general
+    // register and broadcasts it, three instructions at every use; a
+    // broadcast load of the constant is one, and a loop invariant.
+    template <int K> [[gnu::always_inline]] static I splat_i() {
+#if defined(__GNUC__) && !defined(__clang__)
+        I r;
+        asm("vpbroadcastd %1, %0" : "=x"(r) : "m"(simd_detail::Splat<K>::value));
+        return r;
+#else
+        return _mm256_set1_epi32(K);
+#endif
+    }
     static F set1_f(float v) { return _mm256_set1_ps(v); }
     static F zero_f() { return _mm256_setzero_ps(); }
     static I lane_bits() { return _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128); }
@@ -122,6 +139,7 @@ template <> struct Simd<4> {
     static F load_f(const float* p) { return _mm_load_ps(p); }
     static void store_f(float* p, F v) { _mm_store_ps(p, v); }
     static I set1_i(int v) { return _mm_set1_epi32(v); }
+    template <int K> static I splat_i() { return _mm_set1_epi32(K); }
     static F set1_f(float v) { return _mm_set1_ps(v); }
     static F zero_f() { return _mm_setzero_ps(); }
     static I lane_bits() { return _mm_setr_epi32(1, 2, 4, 8); }
@@ -193,6 +211,7 @@ template <> struct Simd<16> {
     static F load_f(const float* p) { return _mm512_load_ps(p); }
     static void store_f(float* p, F v) { _mm512_store_ps(p, v); }
     static I set1_i(int v) { return _mm512_set1_epi32(v); }
+    template <int K> static I splat_i() { return _mm512_set1_epi32(K); }
     static F set1_f(float v) { return _mm512_set1_ps(v); }
     static F zero_f() { return _mm512_setzero_ps(); }
     static I lane_bits() {
