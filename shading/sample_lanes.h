@@ -677,26 +677,22 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
     using V = Simd<W>;
     using F = typename V::F;
     using I = typename V::I;
-    const std::uint16_t* srgb_codes[4] = {nullptr, nullptr, nullptr, nullptr};
-    for (int c = 0; c < C; ++c) srgb_codes[c] = tex.srgb(c) ? tex.code_table(c) : nullptr;
+    const std::uint16_t* const* srgb_codes = tex.srgb_code_tables();
     const std::uint16_t* codes = W == 8 && C >= 3 ? tex.unorm8_codes(at.levels) : nullptr;
-    // What every group of W lanes does alike, worked out once: the stored
-    // channels needed, and each written output's destination and source
-    // channel (-1: the constant 1).
+    // What every group of W lanes does alike (Texture::unorm8_reads()): the
+    // stored channels needed, and each written output's destination and
+    // source channel (-1: the constant 1).
+    const Texture::Unorm8Reads& reads = tex.unorm8_reads(components);
     float* const all_dst[4] = {out.r, out.g, out.b, out.a};
     float* dst[4];
     int src[4];
-    int outputs = 0;
-    unsigned needed = 0;
-    for (int k = 0; k < 4; ++k) {
-        if (!((components >> k) & 1u)) continue;
-        const int sw = tex.swizzle(k);
-        dst[outputs] = all_dst[k];
-        src[outputs++] = sw == Texture::kOne ? -1 : sw;
-        if (sw != Texture::kOne) needed |= 1u << sw;
+    const int outputs = reads.outputs;
+    for (int k = 0; k < outputs; ++k) {
+        dst[k] = all_dst[reads.component[k]];
+        src[k] = reads.channel[k] == Texture::kOne ? -1 : reads.channel[k];
     }
-    bool needs_srgb = false;  // a needed channel is sRGB-encoded
-    for (int c = 0; c < C; ++c) needs_srgb |= ((needed >> c) & 1u) && srgb_codes[c];
+    const unsigned needed = reads.need;
+    const bool needs_srgb = reads.needs_srgb;  // a needed channel is sRGB-encoded
     // The loop over groups, inlined twice: with every stored channel needed
     // (the usual case) `need` is a constant there and its tests fold away.
     auto groups = [&](const unsigned need) __attribute__((always_inline)) {

@@ -582,6 +582,20 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const boo
         // Linear: b * 128 / 32640 is b / 255, which unorm8_decode_table() holds.
         tex.code_[c] = tex.srgb_[c] ? codes.srgb : codes.linear;
         tex.table_[c] = tex.srgb_[c] ? codes.srgb_value : unorm8_decode_table();
+        tex.srgb_code_[c] = tex.srgb_[c] ? codes.srgb : nullptr;
+    }
+    for (unsigned mask = 0; mask < 16; ++mask) {
+        Unorm8Reads& r = tex.reads_[mask];
+        for (int k = 0; k < 4; ++k) {
+            if (!((mask >> k) & 1u)) continue;
+            const int sw = tex.swizzle_[k];
+            r.component[r.outputs] = std::int8_t(k);
+            r.channel[r.outputs++] = std::int8_t(sw);
+            if (sw != kOne) {
+                r.need = std::uint8_t(r.need | 1u << sw);
+                r.needs_srgb = r.needs_srgb || tex.srgb_[sw];
+            }
+        }
     }
     tex.layout(w, h);
     const std::size_t C = std::size_t(channels);

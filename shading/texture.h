@@ -164,6 +164,19 @@ public:
     const std::uint16_t* code_table(int c) const { return code_[c]; }
     // Stored channel c holds sRGB-encoded bytes.
     bool srgb(int c) const { return srgb_[c]; }
+    // code_table(c) of the sRGB channels, null for the linear ones.
+    const std::uint16_t* const* srgb_code_tables() const { return srgb_code_; }
+    // What an 8-bit lookup of the output components in a mask (bit k: r, g,
+    // b, a) reads, worked out once at construction for the block sampler:
+    // the stored channels needed (bit c), whether one of them is sRGB, and
+    // for each written output in order its component and its stored channel
+    // (kOne: the constant 1).
+    struct Unorm8Reads {
+        std::uint8_t need = 0, outputs = 0;
+        bool needs_srgb = false;
+        std::int8_t component[4] = {}, channel[4] = {};
+    };
+    const Unorm8Reads& unorm8_reads(unsigned components) const { return reads_[components & 15u]; }
 
     // The 8-bit filter's steps (file comment), shared by the scalar sampler
     // and the block sampler's lanes: per stored channel, an integer in
@@ -289,6 +302,8 @@ private:
     const float* table_[4] = {nullptr, nullptr, nullptr, nullptr};
     const std::uint16_t* code_[4] = {nullptr, nullptr, nullptr, nullptr};
     bool srgb_[4] = {false, false, false, false};
+    const std::uint16_t* srgb_code_[4] = {nullptr, nullptr, nullptr, nullptr};
+    Unorm8Reads reads_[16];
     std::size_t total_texels_ = 0;
     std::size_t memory_bytes_ = 0;
     Level levels_[kMaxLevels];
