@@ -811,6 +811,22 @@ inline void prepare_trilinear_lanes(const Texture& tex, const float* u, const fl
     float t[kMaxQuadSlots] = {};
     std::uint32_t blend_quads = 0, nearest_quads = 0;
     const int last = tex.levels() - 1;
+#ifdef __AVX2__
+    if (unpacked && live_quads == 0xFu && tex.default_filters()) {
+        // The loop below for the four quads of a block at once: the same
+        // comparisons, floor and subtraction per quad.
+        const __m128 lam = _mm_loadu_ps(lambda);
+        const __m128 minify = _mm_cmpgt_ps(lam, _mm_setzero_ps());  // false for NaN
+        const __m128 between = _mm_andnot_ps(_mm_cmpge_ps(lam, _mm_set1_ps(float(last))), minify);
+        const __m128 fl = _mm_floor_ps(lam);
+        const __m128 tq = _mm_and_ps(between, _mm_sub_ps(lam, fl));
+        const __m128i at_last = _mm_and_si128(_mm_castps_si128(minify), _mm_set1_epi32(last));
+        const __m128i level = _mm_blendv_epi8(at_last, _mm_cvttps_epi32(fl), _mm_castps_si128(between));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(la), level);
+        _mm_storeu_ps(t, tq);
+        blend_quads = std::uint32_t(_mm_movemask_ps(_mm_cmpneq_ps(tq, _mm_setzero_ps())));
+    } else
+#endif
     if (tex.default_filters()) {
         for (std::uint32_t qs = live_quads; qs; qs &= qs - 1) {
             const int q = __builtin_ctz(qs);

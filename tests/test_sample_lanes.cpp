@@ -160,6 +160,22 @@ void check_sampler(std::uint32_t seed, bool filtered = false, const SamplerState
         CHECK(bits(out.b[l]) == bits(ref.b));
         CHECK(bits(out.a[l]) == bits(ref.a));
     }
+    // Sixteen lanes in block order are also the unpacked block (no quad
+    // list; lane l in quad l / 4), which chooses its levels on its own path.
+    if (N == kBlockLanes) {
+        TrilinearLanes block;
+        prepare_trilinear_lanes<N>(tex, u, v, lambda, nullptr, pk.live, block);
+        TexelLanes block_out;
+        fetch_trilinear_lanes<N>(tex, block, block_out);
+        for (int l = 0; l < N; ++l) {
+            if (!((pk.live >> l) & 1u)) continue;
+            INFO("seed ", seed, " unpacked lane ", l, " lambda ", lambda[l / 4], " levels ", tex.levels());
+            CHECK(bits(block_out.r[l]) == bits(out.r[l]));
+            CHECK(bits(block_out.g[l]) == bits(out.g[l]));
+            CHECK(bits(block_out.b[l]) == bits(out.b[l]));
+            CHECK(bits(block_out.a[l]) == bits(out.a[l]));
+        }
+    }
     // A subset of the components, as the material asks for them: those
     // asked for are the same bits, whichever stored channels that leaves
     // the 8-bit fetch to read.
