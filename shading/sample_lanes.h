@@ -693,9 +693,11 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
     }
     const unsigned needed = reads.need;
     const bool needs_srgb = reads.needs_srgb;  // a needed channel is sRGB-encoded
-    // The loop over groups, inlined twice: with every stored channel needed
-    // (the usual case) `need` is a constant there and its tests fold away.
-    auto groups = [&](const unsigned need) __attribute__((always_inline)) {
+    // The loop over groups, inlined three times: with every stored channel
+    // needed (the usual case) `need` is a constant there and its tests fold
+    // away, and where each output is its own channel the values stay in
+    // registers.
+    auto groups = [&](const unsigned need, const bool identity) __attribute__((always_inline)) {
         for (int l0 = 0; l0 < N; l0 += W) {
             const unsigned live = (at.live >> l0) & ((1u << W) - 1u);
             if (!live) {
@@ -721,6 +723,10 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
             F value[4] = {zero, zero, zero, zero};
             for (int c = 0; c < C; ++c)
                 if ((need >> c) & 1u) value[c] = V::div(V::cvt(res[c]), full);  // Texture::fix_value()
+            if (identity) {
+                for (int c = 0; c < C; ++c) V::store_f(all_dst[c] + l0, V::select(live_mask, value[c], zero));
+                continue;
+            }
             for (int k = 0; k < outputs; ++k) {
                 const F v = src[k] < 0 ? V::set1_f(1.0f) : value[src[k]];
                 V::store_f(dst[k] + l0, V::select(live_mask, v, zero));
@@ -728,8 +734,9 @@ inline void fetch_unorm8_lanes(const Texture& tex, const TrilinearLanes& at, Tex
         }
     };
     constexpr unsigned kAll = (1u << C) - 1u;
-    if (needed == kAll) groups(kAll);
-    else groups(needed);
+    if (needed == kAll && reads.identity) groups(kAll, true);
+    else if (needed == kAll) groups(kAll, false);
+    else groups(needed, false);
 }
 
 // Blocks with at most this many live lanes read them one by one.

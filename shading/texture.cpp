@@ -596,6 +596,8 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const boo
                 r.needs_srgb = r.needs_srgb || tex.srgb_[sw];
             }
         }
+        r.identity = r.outputs == channels;
+        for (int k = 0; k < r.outputs; ++k) r.identity = r.identity && r.component[k] == k && r.channel[k] == k;
     }
     tex.layout(w, h);
     const std::size_t C = std::size_t(channels);

@@ -171,9 +171,11 @@ public:
     // the stored channels needed (bit c), whether one of them is sRGB, and
     // for each written output in order its component and its stored channel
     // (kOne: the constant 1).
+    // identity: the outputs are components 0 .. channels() - 1, each from
+    // its own stored channel.
     struct Unorm8Reads {
         std::uint8_t need = 0, outputs = 0;
-        bool needs_srgb = false;
+        bool needs_srgb = false, identity = false;
         std::int8_t component[4] = {}, channel[4] = {};
     };
     const Unorm8Reads& unorm8_reads(unsigned components) const { return reads_[components & 15u]; }
