@@ -20,17 +20,22 @@ bool use_avx512_vbmi() {
 #endif
 
 #if PRAST_CALLS_AVX512
-bool use_avx512() {
-    static const bool use = [] {
-        const char* env = std::getenv("PRAST_AVX512");
-        if (env && std::strcmp(env, "0") == 0) return false;
-        // libgcc's check includes the OS saving the AVX-512 registers (XCR0).
-        __builtin_cpu_init();
-        return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-               __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
-    }();
-    return use;
+namespace isa_detail {
+std::atomic<int> g_avx512{0};
+
+// Threads that race here compute the same answer.
+int read_avx512() {
+    const char* env = std::getenv("PRAST_AVX512");
+    // libgcc's check includes the OS saving the AVX-512 registers (XCR0).
+    __builtin_cpu_init();
+    const bool use = !(env && std::strcmp(env, "0") == 0) && __builtin_cpu_supports("avx512f") &&
+                     __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+                     __builtin_cpu_supports("avx512vl");
+    const int state = use ? 2 : 1;
+    g_avx512.store(state, std::memory_order_relaxed);
+    return state;
 }
+} // namespace isa_detail
 #endif
 
 const char* lane_isa() {

@@ -25,6 +25,10 @@
 #define PRAST_CALLS_VBMI 0
 #endif
 
+#if PRAST_CALLS_AVX512
+#include <atomic>
+#endif
+
 namespace prast {
 
 // Tags for the instruction set a lane loop is instantiated for: the copy
@@ -35,9 +39,17 @@ struct IsaAvx512 {};
 struct IsaAvx512Vbmi {};  // the 8-bit fetch alone, also with AVX512_VBMI
 
 #if PRAST_CALLS_AVX512
+namespace isa_detail {
+extern std::atomic<int> g_avx512;  // 0: not read yet, 1: no, 2: yes
+int read_avx512();                 // reads it, stores it, returns it
+} // namespace isa_detail
 // The CPU runs AVX-512 (F, BW, DQ, VL) and PRAST_AVX512 is not 0 in the
-// environment; read once.
-bool use_avx512();
+// environment; read once. Inline: the block loops ask several times a block.
+[[gnu::always_inline]] inline bool use_avx512() {
+    int state = isa_detail::g_avx512.load(std::memory_order_relaxed);
+    if (__builtin_expect(state == 0, 0)) state = isa_detail::read_avx512();
+    return state == 2;
+}
 #endif
 
 #if defined(PRAST_AVX512_DISPATCH)
