@@ -107,7 +107,7 @@ FrameError prepare_scene(const FrameRequest& req, FrameSetup& out, const FrameSt
     if (req.loaded) {
         out.scene = *req.loaded;
     } else if (req.scene.empty()) {
-        DefaultScene d = make_default_scene();
+        DefaultScene d = make_default_scene(req.threads);
         out.scene = std::move(d.scene);
         camera = d.camera;
     } else {

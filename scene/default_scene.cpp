@@ -2,8 +2,14 @@
 #include "scene/default_scene.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <exception>
+#include <functional>
 #include <memory>
+#include <system_error>
+#include <thread>
+#include <vector>
 
 #include "scene/det_math.h"
 #include "scene/mesh_gen.h"
@@ -36,12 +42,19 @@ Image make_default_sky(int width) {
     const glm::vec3 ground(0.07f, 0.06f, 0.05f), sun(60.0f, 55.0f, 48.0f);
     const float sun_radius = 0.03f;  // radians, about 1.7 degrees
     const float texel = 3.14159265f / float(img.height);
-    for (int y = 0; y < img.height; ++y)
+    // The direction of a texel centre (docs/conventions.md "Environment maps"):
+    // its sines and cosines of phi per column and of theta per row.
+    std::vector<float> sin_phi(std::size_t(img.width)), cos_phi(std::size_t(img.width));
+    for (int x = 0; x < img.width; ++x) {
+        const float phi = ((float(x) + 0.5f) / float(img.width) - 0.5f) * 6.28318531f;
+        sin_phi[std::size_t(x)] = det::sin(phi);
+        cos_phi[std::size_t(x)] = det::cos(phi);
+    }
+    for (int y = 0; y < img.height; ++y) {
+        const float theta = (float(y) + 0.5f) / float(img.height) * 3.14159265f;
+        const float sin_theta = det::sin(theta), cos_theta = det::cos(theta);
         for (int x = 0; x < img.width; ++x) {
-            // The direction of the texel centre (docs/conventions.md "Environment maps").
-            const float phi = ((float(x) + 0.5f) / float(img.width) - 0.5f) * 6.28318531f;
-            const float theta = (float(y) + 0.5f) / float(img.height) * 3.14159265f;
-            const glm::vec3 d(det::sin(theta) * det::sin(phi), det::cos(theta), -det::sin(theta) * det::cos(phi));
+            const glm::vec3 d(sin_theta * sin_phi[std::size_t(x)], cos_theta, -sin_theta * cos_phi[std::size_t(x)]);
             const float up = std::max(d.y, 0.0f);
             glm::vec3 sky = glm::mix(horizon, zenith, std::sqrt(up));
             // The ground darkens towards the nadir; one texel of blend at the horizon.
@@ -53,12 +66,55 @@ Image make_default_sky(int width) {
             c += glm::vec3(1.0f, 0.9f, 0.7f) * (0.6f * det::exp(-angle / 0.12f));
             img.set(x, y, glm::vec4(c, 1.0f));
         }
+    }
     return img;
 }
 
-DefaultScene make_default_scene() {
+namespace {
+// Runs every job, on up to `threads` threads (this one included; 0: all
+// hardware threads), each thread taking the next job not yet taken; with
+// no thread started, this one runs them all. A job's exception is rethrown
+// here.
+void run_jobs(const std::vector<std::function<void()>>& jobs, int threads) {
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    const std::size_t n = jobs.size();
+    std::vector<std::exception_ptr> failed(n);
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+        for (std::size_t i; (i = next.fetch_add(1)) < n;) {
+            try {
+                jobs[i]();
+            } catch (...) {
+                failed[i] = std::current_exception();
+            }
+        }
+    };
+    std::vector<std::thread> started;
+    for (std::size_t k = 1; k < std::min(n, std::size_t(threads)); ++k) {
+        try {
+            started.emplace_back(work);
+        } catch (const std::system_error&) {
+            break;
+        }
+    }
+    work();
+    for (std::thread& t : started) t.join();
+    for (const std::exception_ptr& e : failed)
+        if (e) std::rethrow_exception(e);
+}
+} // namespace
+
+DefaultScene make_default_scene(int threads) {
     DefaultScene d;
     Scene& s = d.scene;
+
+    // The four images take most of the build; they are independent.
+    Image albedo_img, normal_img, rm_img, sky_img;
+    run_jobs({[&] { albedo_img = make_tiles_albedo(kTextureSize); },
+              [&] { normal_img = make_tiles_normal(kTextureSize); },
+              [&] { rm_img = make_tiles_roughness_metal(kTextureSize); },
+              [&] { sky_img = make_default_sky(kSkyWidth); }},
+             threads);
 
     // Procedural tile textures, already linear.
     auto add_image = [&](Image img, const char* name) {
@@ -68,9 +124,9 @@ DefaultScene make_default_scene() {
         s.images.push_back(std::move(src));
         return int(s.images.size() - 1);
     };
-    int albedo = add_image(make_tiles_albedo(kTextureSize), "builtin:tiles_albedo");
-    int normal = add_image(make_tiles_normal(kTextureSize), "builtin:tiles_normal");
-    int rm = add_image(make_tiles_roughness_metal(kTextureSize), "builtin:tiles_roughness_metal");
+    int albedo = add_image(std::move(albedo_img), "builtin:tiles_albedo");
+    int normal = add_image(std::move(normal_img), "builtin:tiles_normal");
+    int rm = add_image(std::move(rm_img), "builtin:tiles_roughness_metal");
 
     // One material per sphere: a warm gold-white base colour.
     for (int row = 0; row < kRows; ++row)
@@ -108,7 +164,7 @@ DefaultScene make_default_scene() {
     lamp.color = glm::vec3(0.6f, 0.75f, 1.0f);
     lamp.intensity = 12.0f;
     s.lights = {sun, lamp};
-    s.environment = std::make_shared<const Image>(make_default_sky(kSkyWidth));
+    s.environment = std::make_shared<const Image>(std::move(sky_img));
 
     d.camera.eye = glm::vec3(0.0f, 3.2f, 7.6f);
     d.camera.target = glm::vec3(0.0f, 1.9f, 0.0f);

@@ -17,7 +17,9 @@ struct DefaultScene {
     Camera camera;  // the framing the README image uses (for 16:9)
 };
 
-DefaultScene make_default_scene();
+// The four images (three tile maps and the sky) are made on up to `threads`
+// threads (0: all hardware threads); each image is the same either way.
+DefaultScene make_default_scene(int threads = 1);
 
 // The built-in scene's environment, an equirect map of `width` x width/2
 // texels (linear radiance): a sky from a pale horizon to a blue zenith, a

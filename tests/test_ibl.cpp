@@ -539,6 +539,42 @@ TEST_CASE("precomputation is byte-identical for 1, 2 and 3 threads") {
     }
 }
 
+TEST_CASE("the GGX prefilter's eight-texel lanes give the scalar loop's bits") {
+    // Widths with and without a tail of fewer than eight texels, each
+    // roughness level's filter, a map with odd-sized mips and one with a
+    // 2000x sun (texel values far apart), against PrefilterPath::Scalar.
+    const Image maps[2] = {procedural_env(300), make_env(256, [](const glm::dvec3& d) {
+                               const float sky = 0.25f + 0.5f * float(d.y * d.y);
+                               return glm::vec3(glm::dot(d, kProceduralSun) > 0.999 ? 2000.0f : sky);
+                           })};
+    for (const Image& img : maps) {
+        const Environment env = Environment::build(img, {}, pool2());
+        EquirectLevel mips[32];
+        for (int k = 0; k < env.source_levels(); ++k) mips[k] = env.source_level(k);
+        const std::size_t base = std::size_t(mips[env.source_levels() - 1].offset) + 1;
+        for (int level = 1; level < Environment::kSpecularLevels; ++level)
+            for (int w : {8, 37, 64, 150}) {
+                CAPTURE(level);
+                CAPTURE(w);
+                std::vector<glm::vec4> texels(env.texels(), env.texels() + base);
+                EquirectLevel out[2];
+                for (EquirectLevel& o : out) {
+                    o.w = w; o.h = std::max(1, w / 2); o.fw = float(o.w); o.fh = float(o.h);
+                    o.offset = std::int32_t(texels.size());
+                    texels.resize(texels.size() + std::size_t(o.w) * std::size_t(o.h), glm::vec4(-1.0f));
+                }
+                const float r = Environment::level_roughness(level);
+                const int n = Environment::kSpecularSamples[level];
+                prefilter_ggx(texels.data(), mips, env.source_levels(), r, n, out[0], pool2(), PrefilterPath::Lanes);
+                prefilter_ggx(texels.data(), mips, env.source_levels(), r, n, out[1], pool2(), PrefilterPath::Scalar);
+                const std::size_t count = std::size_t(out[0].w) * std::size_t(out[0].h);
+                CHECK(std::memcmp(texels.data() + out[0].offset, texels.data() + out[1].offset,
+                                  count * sizeof(glm::vec4)) == 0);
+                CHECK(texels[std::size_t(out[0].offset)].x >= 0.0f);
+            }
+    }
+}
+
 TEST_CASE("rendering with an environment is byte-identical for any thread count and tile size") {
     Scene scene;
     scene.environment = std::make_shared<const Image>(procedural_env(128));

@@ -79,6 +79,23 @@ TEST_CASE("built-in scene matches its golden image") {
     CHECK(diff.match);  // at most floor(0.001 * W * H) pixels differ at all
 }
 
+TEST_CASE("the built-in scene's images are the same made on 1, 2, 4 or all threads") {
+    const DefaultScene one = make_default_scene(1);
+    REQUIRE(one.scene.images.size() == 3);
+    REQUIRE(one.scene.environment);
+    for (int threads : {2, 4, 0}) {
+        CAPTURE(threads);
+        const DefaultScene d = make_default_scene(threads);
+        REQUIRE(d.scene.images.size() == one.scene.images.size());
+        for (std::size_t i = 0; i < d.scene.images.size(); ++i) {
+            CHECK(d.scene.images[i].name == one.scene.images[i].name);
+            CHECK(d.scene.images[i].decoded->rgba == one.scene.images[i].decoded->rgba);
+        }
+        CHECK(d.scene.environment->rgba == one.scene.environment->rgba);
+        CHECK(d.scene.environment->width == 512);
+    }
+}
+
 TEST_CASE("PBR frames are byte-identical for any thread count and tile size") {
     DefaultScene d = make_default_scene();
     const int W = 203, H = 117;  // not a multiple of 4 or of any tile size

@@ -27,7 +27,10 @@ void resample_equirect(glm::vec4* texels, const EquirectLevel& in, const Equirec
 // n = v = the texel's direction and h GGX-distributed for roughness r (alpha =
 // r^2); L read trilinearly from the `mip_count` source levels `mips` at the
 // filtered-importance-sampling level, 0.5 log2(omega_sample / omega_texel) + 1.
+// `Lanes` runs eight texels of a row at a time where the build has AVX2,
+// with the same bits as `Scalar`, one texel at a time (the test's reference).
+enum class PrefilterPath { Lanes, Scalar };
 void prefilter_ggx(glm::vec4* texels, const EquirectLevel* mips, int mip_count, float roughness, int samples,
-                   const EquirectLevel& out, ThreadPool& pool);
+                   const EquirectLevel& out, ThreadPool& pool, PrefilterPath path = PrefilterPath::Lanes);
 
 } // namespace prast
