@@ -108,13 +108,15 @@ DefaultScene make_default_scene(int threads) {
     DefaultScene d;
     Scene& s = d.scene;
 
-    // The four images take most of the build; they are independent.
-    Image albedo_img, normal_img, rm_img, sky_img;
-    run_jobs({[&] { albedo_img = make_tiles_albedo(kTextureSize); },
-              [&] { normal_img = make_tiles_normal(kTextureSize); },
-              [&] { rm_img = make_tiles_roughness_metal(kTextureSize); },
-              [&] { sky_img = make_default_sky(kSkyWidth); }},
-             threads);
+    // The images take most of the build: the sky, and the tile maps in bands
+    // of rows.
+    TileMaps maps = tile_maps_storage(kTextureSize);
+    Image sky_img;
+    std::vector<std::function<void()>> jobs = {[&] { sky_img = make_default_sky(kSkyWidth); }};
+    constexpr int kBand = 32;
+    for (int y = 0; y < kTextureSize; y += kBand)
+        jobs.push_back([&maps, y] { fill_tile_map_rows(maps, y, std::min(y + kBand, kTextureSize)); });
+    run_jobs(jobs, threads);
 
     // Procedural tile textures, already linear.
     auto add_image = [&](Image img, const char* name) {
@@ -124,9 +126,9 @@ DefaultScene make_default_scene(int threads) {
         s.images.push_back(std::move(src));
         return int(s.images.size() - 1);
     };
-    int albedo = add_image(std::move(albedo_img), "builtin:tiles_albedo");
-    int normal = add_image(std::move(normal_img), "builtin:tiles_normal");
-    int rm = add_image(std::move(rm_img), "builtin:tiles_roughness_metal");
+    int albedo = add_image(std::move(maps.albedo), "builtin:tiles_albedo");
+    int normal = add_image(std::move(maps.normal), "builtin:tiles_normal");
+    int rm = add_image(std::move(maps.roughness_metal), "builtin:tiles_roughness_metal");
 
     // One material per sphere: a warm gold-white base colour.
     for (int row = 0; row < kRows; ++row)

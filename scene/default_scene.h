@@ -17,7 +17,7 @@ struct DefaultScene {
     Camera camera;  // the framing the README image uses (for 16:9)
 };
 
-// The four images (three tile maps and the sky) are made on up to `threads`
+// Its images (the three tile maps and the sky) are made on up to `threads`
 // threads (0: all hardware threads); each image is the same either way.
 DefaultScene make_default_scene(int threads = 1);
 

@@ -216,65 +216,114 @@ Image make_checker(int size, int cells, glm::vec4 a, glm::vec4 b) {
     return img;
 }
 
+namespace {
+
+// The three maps' values at one sub-sample, given its brick.
+glm::vec4 albedo_at(glm::vec2 uv, const BrickPoint& p) {
+    if (p.zone == Zone::Grout) {
+        const float grit = table_noise<128, 3U>(uv);
+        return glm::vec4(glm::vec3(kGroutAlbedo * (0.8f + 0.4f * grit)), 1.0f);
+    }
+    const BrickLook& look = look_of(p);
+    const float mottle = table_noise<32, 5U>(uv);
+    // Edges slightly darker where the glaze runs thin.
+    const float edge = p.zone == Zone::Bevel ? 0.85f + 0.15f * p.t : 1.0f;
+    return glm::vec4(glm::min(look.albedo * ((0.92f + 0.16f * mottle) * edge), glm::vec3(1.0f)), 1.0f);
+}
+
+// The unit normal, before the sub-samples' mean is renormalised and encoded.
+glm::vec4 normal_at(glm::vec2, const BrickPoint& p) {
+    // Height gradient (dh/du, dh/dv), as a slope per unit distance.
+    glm::vec2 grad(0.0f);
+    switch (p.zone) {
+    case Zone::Grout:  // concave groove: flat in the middle, rising to the brick
+        grad = p.inward * (0.3f * p.t);
+        break;
+    case Zone::Bevel:  // rounded edge: steepest next to the grout, flat at the face
+        grad = p.inward * (1.1f * (1.0f - p.t)) + look_of(p).tilt;
+        break;
+    case Zone::Face:
+        grad = look_of(p).tilt;
+        break;
+    }
+    // Tangent space: x along T = +u, y along B = -v (up the image), so
+    // n = (-dh/du, +dh/dv, 1), normalised.
+    return glm::vec4(glm::normalize(glm::vec3(-grad.x, grad.y, 1.0f)), 0.0f);
+}
+
+// Renormalises a mean of normal_at and encodes it as 0.5 n + 0.5.
+glm::vec4 encode_normal(glm::vec4 mean) {
+    const glm::vec3 n = glm::normalize(glm::vec3(mean));
+    return glm::vec4(n * 0.5f + 0.5f, 1.0f);
+}
+
+glm::vec4 roughness_metal_at(glm::vec2 uv, const BrickPoint& p) {
+    if (p.zone == Zone::Grout) {
+        const float grit = table_noise<128, 3U>(uv);
+        return glm::vec4(0.55f + 0.15f * p.t, 0.85f + 0.1f * grit, 0.0f, 1.0f);
+    }
+    const BrickLook& look = look_of(p);
+    const float ao = p.zone == Zone::Bevel ? 0.85f + 0.15f * p.t : 1.0f;
+    const float wear = table_noise<32, 9U>(uv);
+    return glm::vec4(ao, look.roughness * (0.9f + 0.2f * wear), look.metallic, 1.0f);
+}
+
+} // namespace
+
 Image make_tiles_albedo(int size) {
     check_size("make_tiles_albedo", size);
-    return render_procedural(size, [](glm::vec2 uv) {
-        const BrickPoint p = brick_at(uv);
-        if (p.zone == Zone::Grout) {
-            const float grit = table_noise<128, 3U>(uv);
-            return glm::vec4(glm::vec3(kGroutAlbedo * (0.8f + 0.4f * grit)), 1.0f);
-        }
-        const BrickLook& look = look_of(p);
-        const float mottle = table_noise<32, 5U>(uv);
-        // Edges slightly darker where the glaze runs thin.
-        const float edge = p.zone == Zone::Bevel ? 0.85f + 0.15f * p.t : 1.0f;
-        return glm::vec4(glm::min(look.albedo * ((0.92f + 0.16f * mottle) * edge), glm::vec3(1.0f)), 1.0f);
-    });
+    return render_procedural(size, [](glm::vec2 uv) { return albedo_at(uv, brick_at(uv)); });
 }
 
 Image make_tiles_normal(int size) {
     check_size("make_tiles_normal", size);
-    Image img = render_procedural(size, [](glm::vec2 uv) {
-        const BrickPoint p = brick_at(uv);
-        // Height gradient (dh/du, dh/dv), as a slope per unit distance.
-        glm::vec2 grad(0.0f);
-        switch (p.zone) {
-        case Zone::Grout:  // concave groove: flat in the middle, rising to the brick
-            grad = p.inward * (0.3f * p.t);
-            break;
-        case Zone::Bevel:  // rounded edge: steepest next to the grout, flat at the face
-            grad = p.inward * (1.1f * (1.0f - p.t)) + look_of(p).tilt;
-            break;
-        case Zone::Face:
-            grad = look_of(p).tilt;
-            break;
-        }
-        // Tangent space: x along T = +u, y along B = -v (up the image), so
-        // n = (-dh/du, +dh/dv, 1), normalised.
-        return glm::vec4(glm::normalize(glm::vec3(-grad.x, grad.y, 1.0f)), 0.0f);
-    });
-    // Renormalise the averaged sub-samples and encode 0.5 n + 0.5.
+    Image img = render_procedural(size, [](glm::vec2 uv) { return normal_at(uv, brick_at(uv)); });
     for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) {
-            const glm::vec3 n = glm::normalize(glm::vec3(img.at(x, y)));
-            img.set(x, y, glm::vec4(n * 0.5f + 0.5f, 1.0f));
-        }
+        for (int x = 0; x < size; ++x) img.set(x, y, encode_normal(img.at(x, y)));
     return img;
 }
 
 Image make_tiles_roughness_metal(int size) {
     check_size("make_tiles_roughness_metal", size);
-    return render_procedural(size, [](glm::vec2 uv) {
-        const BrickPoint p = brick_at(uv);
-        if (p.zone == Zone::Grout) {
-            const float grit = table_noise<128, 3U>(uv);
-            return glm::vec4(0.55f + 0.15f * p.t, 0.85f + 0.1f * grit, 0.0f, 1.0f);
+    return render_procedural(size, [](glm::vec2 uv) { return roughness_metal_at(uv, brick_at(uv)); });
+}
+
+TileMaps tile_maps_storage(int size) {
+    check_size("tile_maps_storage", size);
+    TileMaps m;
+    for (Image* img : {&m.albedo, &m.normal, &m.roughness_metal}) {
+        img->width = img->height = size;
+        img->rgba.assign(std::size_t(size) * std::size_t(size) * 4, 0.0f);
+    }
+    return m;
+}
+
+void fill_tile_map_rows(TileMaps& maps, int y0, int y1) {
+    const int size = maps.albedo.width;
+    const float inv = 1.0f / float(size);
+    for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < size; ++x) {
+            // render_procedural's sub-samples and sums, in its order, for each map.
+            glm::vec4 albedo(0.0f), normal(0.0f), rm(0.0f);
+            for (int sy = 0; sy < 2; ++sy)
+                for (int sx = 0; sx < 2; ++sx) {
+                    const glm::vec2 uv((float(x) + 0.25f + 0.5f * float(sx)) * inv,
+                                       (float(y) + 0.25f + 0.5f * float(sy)) * inv);
+                    const BrickPoint p = brick_at(uv);
+                    albedo += albedo_at(uv, p);
+                    normal += normal_at(uv, p);
+                    rm += roughness_metal_at(uv, p);
+                }
+            maps.albedo.set(x, y, albedo * 0.25f);
+            maps.normal.set(x, y, encode_normal(normal * 0.25f));
+            maps.roughness_metal.set(x, y, rm * 0.25f);
         }
-        const BrickLook& look = look_of(p);
-        const float ao = p.zone == Zone::Bevel ? 0.85f + 0.15f * p.t : 1.0f;
-        const float wear = table_noise<32, 9U>(uv);
-        return glm::vec4(ao, look.roughness * (0.9f + 0.2f * wear), look.metallic, 1.0f);
-    });
+}
+
+TileMaps make_tile_maps(int size) {
+    TileMaps m = tile_maps_storage(size);
+    fill_tile_map_rows(m, 0, size);
+    return m;
 }
 
 } // namespace prast

@@ -34,4 +34,15 @@ Image make_tiles_normal(int size);
 // bricks smooth-ish, grout rough), B = metallic (1 on the gold bricks).
 Image make_tiles_roughness_metal(int size);
 
+// The three maps above, the same texels, made together: each sub-sample's
+// brick is worked out once for all three. tile_maps_storage() allocates
+// them; fill_tile_map_rows() makes rows [y0, y1) of each, so that bands of
+// rows can be made on different threads.
+struct TileMaps {
+    Image albedo, normal, roughness_metal;
+};
+TileMaps tile_maps_storage(int size);
+void fill_tile_map_rows(TileMaps& maps, int y0, int y1);
+TileMaps make_tile_maps(int size);
+
 } // namespace prast

@@ -700,6 +700,16 @@ TEST_CASE("procedural brick textures") {
     // Deterministic.
     CHECK(make_tiles_albedo(size).rgba == albedo.rgba);
     CHECK(make_tiles_normal(size).rgba == normal.rgba);
+    // Made together (as the built-in scene does, in bands of rows), the same texels.
+    for (int n : {size, 37}) {
+        CAPTURE(n);
+        TileMaps maps = tile_maps_storage(n);
+        for (int y = n; y > 0; y -= 5) fill_tile_map_rows(maps, std::max(0, y - 5), y);
+        CHECK(maps.albedo.rgba == (n == size ? albedo : make_tiles_albedo(n)).rgba);
+        CHECK(maps.normal.rgba == (n == size ? normal : make_tiles_normal(n)).rgba);
+        CHECK(maps.roughness_metal.rgba == (n == size ? orm : make_tiles_roughness_metal(n)).rgba);
+        CHECK(make_tile_maps(n).normal.rgba == maps.normal.rgba);
+    }
 
     int grout = 0, metal = 0, tilted = 0;
     for (int y = 0; y < size; ++y)

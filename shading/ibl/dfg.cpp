@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "shading/brdf.h"
 #include "shading/ibl/ibl_sampling.h"
@@ -49,12 +50,12 @@ void integrate_specular_row(DfgModel model, double r, glm::dvec2* out) {
 }
 
 // Kd at one n.v: cosine-weighted l (pdf (n.l) / pi), so the integral is the
-// mean of 1 - Fc(v.h).
-double integrate_diffuse_fresnel(double NoV) {
+// mean of 1 - Fc(v.h). `ls` holds the kSamples directions, the same for
+// every n.v.
+double integrate_diffuse_fresnel(double NoV, const std::vector<glm::dvec3>& ls) {
     const glm::dvec3 v(std::sqrt(std::max(0.0, 1.0 - NoV * NoV)), 0.0, NoV);
     double sum = 0.0;
-    for (std::uint32_t i = 0; i < std::uint32_t(DfgTable::kSamples); ++i) {
-        const glm::dvec3 l = sample_cosine(hammersley(i, DfgTable::kSamples));
+    for (const glm::dvec3& l : ls) {
         const glm::dvec3 h = glm::normalize(l + v);
         sum += 1.0 - pow5d(1.0 - std::clamp(glm::dot(v, h), 0.0, 1.0));
     }
@@ -68,10 +69,12 @@ DfgTable DfgTable::build(DfgModel model, ThreadPool& pool) {
     DfgTable t;
     t.model_ = model;
     t.texels_.assign(std::size_t(S) * R, glm::vec4(0.0f));
+    std::vector<glm::dvec3> ls(kSamples);
+    for (int i = 0; i < kSamples; ++i) ls[std::size_t(i)] = sample_cosine(hammersley(std::uint32_t(i), kSamples));
     std::vector<double> kd(S);
     pool.run(S, [&](int i, int) {
         const double c = double(i) / (S - 1);
-        kd[std::size_t(i)] = integrate_diffuse_fresnel(c * c);
+        kd[std::size_t(i)] = integrate_diffuse_fresnel(c * c, ls);
     });
     pool.run(R, [&](int j, int) {
         const double r = std::clamp(double(j) / (R - 1), double(kMinPerceptualRoughness), 1.0);
