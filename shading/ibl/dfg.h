@@ -42,7 +42,10 @@ public:
     static constexpr int kSizeRough = 32;   // texels along roughness
     static constexpr int kSamples = 2048;   // GGX half vectors per texel (Hammersley)
 
-    static DfgTable build(DfgModel model, ThreadPool& pool);
+    // `Lanes` integrates four n.v columns at a time where the build has AVX2,
+    // with the same bits as `Scalar`, one at a time (the test's reference).
+    enum class Path { Lanes, Scalar };
+    static DfgTable build(DfgModel model, ThreadPool& pool, Path path = Path::Lanes);
 
     DfgModel model() const { return model_; }
     // (A, B, Kd, 0) texels, row-major: row j is roughness j / (kSizeRough - 1)
