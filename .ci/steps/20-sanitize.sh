@@ -1,7 +1,9 @@
 #!/bin/sh
 # CI step: the test suite (all but three tests, below) built with ASan and UBSan
-# (PRAST_SANITIZE=ON), every report fatal. -O1: -O0 makes the sanitized suite
-# several times slower for nothing; -g1 (line tables: reports still name file
+# (PRAST_SANITIZE=ON), every report fatal. The libraries at -O1: -O0 makes
+# the sanitized suite several times slower for nothing (the suite's own
+# sources are at -O0, which compiles them three times faster: CMakeLists.txt);
+# -g1 (line tables: reports still name file
 # and line) compiles in half the time of -g. Reports inside
 # Debian's stb_image 2.27 that are known and harmless are suppressed by
 # tests/ubsan.supp (each entry says why); the ones that are not harmless are
