@@ -2,17 +2,14 @@
 #include "scene/default_scene.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <exception>
-#include <functional>
 #include <memory>
-#include <system_error>
 #include <thread>
 #include <vector>
 
 #include "scene/det_math.h"
 #include "scene/mesh_gen.h"
+#include "scene/parallel.h"
 #include "scene/procedural_images.h"
 
 namespace prast {
@@ -70,40 +67,6 @@ Image make_default_sky(int width) {
     return img;
 }
 
-namespace {
-// Runs every job, on up to `threads` threads (this one included; 0: all
-// hardware threads), each thread taking the next job not yet taken; with
-// no thread started, this one runs them all. A job's exception is rethrown
-// here.
-void run_jobs(const std::vector<std::function<void()>>& jobs, int threads) {
-    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-    const std::size_t n = jobs.size();
-    std::vector<std::exception_ptr> failed(n);
-    std::atomic<std::size_t> next{0};
-    auto work = [&] {
-        for (std::size_t i; (i = next.fetch_add(1)) < n;) {
-            try {
-                jobs[i]();
-            } catch (...) {
-                failed[i] = std::current_exception();
-            }
-        }
-    };
-    std::vector<std::thread> started;
-    for (std::size_t k = 1; k < std::min(n, std::size_t(threads)); ++k) {
-        try {
-            started.emplace_back(work);
-        } catch (const std::system_error&) {
-            break;
-        }
-    }
-    work();
-    for (std::thread& t : started) t.join();
-    for (const std::exception_ptr& e : failed)
-        if (e) std::rethrow_exception(e);
-}
-} // namespace
-
 DefaultScene make_default_scene(int threads) {
     DefaultScene d;
     Scene& s = d.scene;
@@ -112,11 +75,17 @@ DefaultScene make_default_scene(int threads) {
     // of rows.
     TileMaps maps = tile_maps_storage(kTextureSize);
     Image sky_img;
-    std::vector<std::function<void()>> jobs = {[&] { sky_img = make_default_sky(kSkyWidth); }};
     constexpr int kBand = 32;
-    for (int y = 0; y < kTextureSize; y += kBand)
-        jobs.push_back([&maps, y] { fill_tile_map_rows(maps, y, std::min(y + kBand, kTextureSize)); });
-    run_jobs(jobs, threads);
+    const int bands = (kTextureSize + kBand - 1) / kBand;
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    run_on_threads(threads, 1 + bands, [&](int task) {
+        if (task == 0) {
+            sky_img = make_default_sky(kSkyWidth);
+        } else {
+            const int y = (task - 1) * kBand;
+            fill_tile_map_rows(maps, y, std::min(y + kBand, kTextureSize));
+        }
+    });
 
     // Procedural tile textures, already linear.
     auto add_image = [&](Image img, const char* name) {

@@ -2,15 +2,14 @@
 #include "scene/encode_png.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstdlib>
-#include <exception>
-#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
 
 #include <zlib.h>
+
+#include "scene/parallel.h"
 
 namespace prast {
 
@@ -100,30 +99,7 @@ PngOptions png_options_threads(int threads) {
     PngOptions o;
     if (threads == 1) return o;
     o.parallel_for = [threads](int count, const std::function<void(int)>& fn) {
-        std::atomic<int> next{0};
-        std::mutex failed_lock;
-        std::exception_ptr failed;  // the first band that threw (out of memory): rethrown here
-        auto work = [&] {
-            try {
-                for (int b = next++; b < count; b = next++) fn(b);
-            } catch (...) {
-                next = count;  // the others stop too
-                const std::lock_guard<std::mutex> lock(failed_lock);
-                if (!failed) failed = std::current_exception();
-            }
-        };
-        std::vector<std::thread> pool;
-        // A thread that cannot be started (a process limit, no memory for its
-        // stack or for the vector) leaves the work to the others; unwinding
-        // past joinable threads would terminate the process.
-        try {
-            pool.reserve(std::size_t(std::min(threads, count)));
-            for (int t = 1; t < std::min(threads, count); ++t) pool.emplace_back(work);
-        } catch (...) {
-        }
-        work();
-        for (std::thread& t : pool) t.join();
-        if (failed) std::rethrow_exception(failed);
+        run_on_threads(threads, count, fn);  // the first band that throws (out of memory): rethrown
     };
     return o;
 }

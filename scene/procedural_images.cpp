@@ -160,6 +160,11 @@ template <int Period, std::uint32_t Seed> float table_noise(glm::vec2 uv) {
     return lattice_noise(uv, Period, [](int i, int j) { return table.v[i + j * Period]; });
 }
 
+// Sub-sample (sx, sy) of texel (x, y), sx and sy in {0, 1}; inv = 1 / size.
+glm::vec2 subsample_uv(int x, int y, int sx, int sy, float inv) {
+    return glm::vec2((float(x) + 0.25f + 0.5f * float(sx)) * inv, (float(y) + 0.25f + 0.5f * float(sy)) * inv);
+}
+
 // Renders f(uv) -> vec4 with 2x2 sub-samples per texel averaged: smoother
 // grout edges at small sizes; the mip chain does the rest.
 template <class F>
@@ -172,9 +177,7 @@ Image render_procedural(int size, F f) {
         for (int x = 0; x < size; ++x) {
             glm::vec4 sum(0.0f);
             for (int sy = 0; sy < 2; ++sy)
-                for (int sx = 0; sx < 2; ++sx)
-                    sum += f(glm::vec2((float(x) + 0.25f + 0.5f * float(sx)) * inv,
-                                       (float(y) + 0.25f + 0.5f * float(sy)) * inv));
+                for (int sx = 0; sx < 2; ++sx) sum += f(subsample_uv(x, y, sx, sy, inv));
             img.set(x, y, sum * 0.25f);
         }
     return img;
@@ -307,8 +310,7 @@ void fill_tile_map_rows(TileMaps& maps, int y0, int y1) {
             glm::vec4 albedo(0.0f), normal(0.0f), rm(0.0f);
             for (int sy = 0; sy < 2; ++sy)
                 for (int sx = 0; sx < 2; ++sx) {
-                    const glm::vec2 uv((float(x) + 0.25f + 0.5f * float(sx)) * inv,
-                                       (float(y) + 0.25f + 0.5f * float(sy)) * inv);
+                    const glm::vec2 uv = subsample_uv(x, y, sx, sy, inv);
                     const BrickPoint p = brick_at(uv);
                     albedo += albedo_at(uv, p);
                     normal += normal_at(uv, p);
