@@ -229,7 +229,10 @@ private:
                 const TriangleSetup& t = job.setups[job.items[i]];
                 TriangleVaryings<Program::kVaryings> pv;
                 prepare_varyings<Program::kVaryings>(t, vertices->data(), job, pv);
-                for_each_block<MS>(t, c, *c.stats, [&](int bx, int by, BlockSamples& bs) {
+                // Inlined at both of for_each_block's calls: most small
+                // triangles take its one-block call, which GCC otherwise
+                // left as a call of the lambda and of its depth test.
+                for_each_block<MS>(t, c, *c.stats, [&](int bx, int by, BlockSamples& bs) __attribute__((always_inline)) {
                     shade_in_order_batched<MS>(program_, state, t, pv, c, bx, by, bs, batch);
                 });
             }

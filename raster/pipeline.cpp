@@ -323,7 +323,11 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
         defer |= double(covered) > double(kOverdrawForVisibility) * double(kCoverScale) * double(r.width()) * double(r.height());
     }
 
-    // Every draw's bins, in submission order.
+    // Every draw's bins, in submission order. Shading in order returns the
+    // samples it writes to kNoWinner; while no winner is pending (none yet,
+    // or flush_winners() just returned them all) they already are, so those
+    // draws see no winner plane (tg.winner null) and skip the stores.
+    std::uint32_t* const winners = tg.winner;
     bool touched = false, pending = false;
     sc.refs.clear();
     for (const std::unique_ptr<raster_detail::DrawRecord>& dp : draws_) {
@@ -339,10 +343,12 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
             if (begin == end) continue;
             touched = true;
             if (d.reads_color && pending && !flushed) {
+                tg.winner = winners;
                 flush_winners(c, sc);
                 pending = false;
                 flushed = true;
             }
+            tg.winner = (pending || !in_order) ? winners : nullptr;
             if (d.state.topology != Topology::Triangles) {
                 d.rasterize_lines(job, begin, end, c);
                 continue;
@@ -376,6 +382,7 @@ void Renderer::run_tile(int tile, int worker, TileHook hook, void* user) {
             }
         }
     }
+    tg.winner = winners;
     if (pending) flush_winners(c, sc);
     stats.tiles_touched += touched;
 

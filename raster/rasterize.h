@@ -450,7 +450,7 @@ inline void block_coverage(const TriangleSetup& t, const TileContext& c, const T
 // samples at once: the classifications only skip work, so the coverage is
 // the same.
 template <bool MS, class BlockFn>
-inline void for_each_block(const TriangleSetup& t, const TileContext& c, FrameStats& stats, BlockFn&& fn) {
+[[gnu::always_inline]] inline void for_each_block(const TriangleSetup& t, const TileContext& c, FrameStats& stats, BlockFn&& fn) {
     // The part of the tile the triangle's box overlaps (inclusive pixels).
     const int x0 = std::max(c.x0, t.minx), x1 = std::min(c.x1, t.maxx);
     const int y0 = std::max(c.y0, t.miny), y1 = std::min(c.y1, t.maxy);
