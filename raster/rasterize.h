@@ -209,7 +209,7 @@ inline __m256i half_row_mask(std::uint32_t mask_bits) {
 // The 16 values of a block in lane order from a row-major buffer; lanes
 // outside `mask` read 0 unless the whole block is inside the buffer (`full`).
 // Masked-out lanes are never touched (the block may straddle the buffer's end).
-inline void load_block(const float* p, std::size_t row, bool full, std::uint32_t mask, float* out) {
+[[gnu::always_inline]] inline void load_block(const float* p, std::size_t row, bool full, std::uint32_t mask, float* out) {
 #if defined(__AVX2__)
     const std::uint32_t m = full ? 0xFFFFu : mask;
     for (int h = 0; h < kBlockLanes; h += 8, p += 2 * row) {
@@ -244,7 +244,7 @@ inline void store_row(float* p, __m128i mask, __m128 v, bool whole) {
 #endif
 
 // `whole`: the block lies inside the buffer (block_inside()).
-inline void store_block(float* p, std::size_t row, std::uint32_t mask, const float* v, bool whole) {
+[[gnu::always_inline]] inline void store_block(float* p, std::size_t row, std::uint32_t mask, const float* v, bool whole) {
 #if defined(__AVX2__)
     for (int h = 0; h < kBlockLanes; h += 8, p += 2 * row) {
         if (!((mask >> h) & 0xFFu)) continue;
@@ -296,7 +296,7 @@ inline void load_winners(const std::uint32_t* p, std::size_t row, std::uint32_t*
 // pixel centres moved by (sx, sy) pixels (a sample's offset; kOffset false:
 // the centres themselves, with exactly the one-sample float operations).
 template <bool kOffset>
-inline void block_barycentrics(const TriangleSetup& t, int bx, int by, float sx, float sy, float* b0, float* b1,
+[[gnu::always_inline]] inline void block_barycentrics(const TriangleSetup& t, int bx, int by, float sx, float sy, float* b0, float* b1,
                                float* b2) {
     const float ox = float(bx - t.ax), oy = float(by - t.ay);
     for (int l = 0; l < kBlockLanes; ++l) {
@@ -317,7 +317,7 @@ inline float depth_from_barycentrics(const TriangleSetup& t, float b0, float b1,
 }
 
 // depth_from_barycentrics for the 16 lanes, eight at a time.
-inline void block_depths(const TriangleSetup& t, const float* b0, const float* b1, const float* b2, float* z) {
+[[gnu::always_inline]] inline void block_depths(const TriangleSetup& t, const float* b0, const float* b1, const float* b2, float* z) {
     for (int h = 0; h < kBlockLanes; h += 8) {
         Lanes8 q0, q1, q2;
         load_lanes(q0, b0 + h);
@@ -365,7 +365,7 @@ inline bool block_inside(const TileContext& c, int bx, int by) {
 // covered sample passes without a depth test). `all_z`: also the depths of
 // samples nothing covers (for observers).
 template <bool MS>
-inline void test_depth(const TriangleSetup& t, const TileContext& c, int bx, int by, bool depth_test, bool all_z,
+[[gnu::always_inline]] inline void test_depth(const TriangleSetup& t, const TileContext& c, int bx, int by, bool depth_test, bool all_z,
                        BlockSamples& bs) {
     const TileTarget& tg = c.target;
     const bool full = block_inside(c, bx, by);
@@ -420,7 +420,7 @@ inline void count_fragments(FrameStats& stats, const BlockSamples& bs) {
 // The samples of the 4x4 block at (bx, by) inside the edges in `partial`
 // (the others hold the whole block) and the viewport: bs.cover, bs.any_cover.
 template <bool MS>
-inline void block_coverage(const TriangleSetup& t, const TileContext& c, const TriangleInTile& p, int bx, int by,
+[[gnu::always_inline]] inline void block_coverage(const TriangleSetup& t, const TileContext& c, const TriangleInTile& p, int bx, int by,
                            unsigned partial, BlockSamples& bs) {
     const int S = samples_of<MS>(c);
     const std::uint32_t scissor = scissor_mask(bx, by, c.width, c.height);
