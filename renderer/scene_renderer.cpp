@@ -133,7 +133,11 @@ SceneRenderer::SceneRenderer(const Scene& scene, Renderer& renderer, DecodedImag
             }
             // A map drawn as it is decodes with room for its mip chain (no copy of level 0).
             const PixelCapacity room = direct[slot] ? &Texture::unorm8_bytes : nullptr;
-            images[slot] = src.decoded ? *src.decoded : have ? *have : decode_image(src, slot % 2 == 1, room);
+            // (Not one conditional expression: its const lvalue arms would make
+            // even the fresh decode a copy, which loses the reserved capacity.)
+            if (src.decoded) images[slot] = *src.decoded;
+            else if (have) images[slot] = *have;
+            else images[slot] = decode_image(src, slot % 2 == 1, room);
             if (kept && !src.decoded && !have) {
                 auto copy = std::make_shared<const Image>(images[slot]);
                 std::lock_guard<std::mutex> lock(kept->mutex);

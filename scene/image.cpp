@@ -350,7 +350,17 @@ bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h
     // square) the zlib path's 256 KiB at a time keeps a huge texture's
     // decode within what the memory plan counted.
     if (raw_size > (std::size_t(128) << 20)) return false;
+    // The IDAT data's size first, so that it is gathered into one buffer
+    // of its size (growing one would copy and fault in about twice that).
+    std::size_t idat_bytes = 0;
+    for (std::size_t pos = 8; pos + 12 <= size;) {
+        const std::uint32_t len = be32(data + pos);
+        if (len > size - pos - 12) return false;
+        if (std::memcmp(data + pos + 4, "IDAT", 4) == 0) idat_bytes += len;
+        pos += 12 + std::size_t(len);
+    }
     std::vector<unsigned char> compressed;
+    compressed.reserve(idat_bytes);
     for (std::size_t pos = 8; pos + 12 <= size;) {
         const std::uint32_t len = be32(data + pos);
         if (len > size - pos - 12) return false;
