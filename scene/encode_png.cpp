@@ -125,7 +125,13 @@ std::vector<std::uint8_t> encode_png_pixels(const std::uint8_t* pixels, int widt
         for (int b = 0; b < count; ++b) run(b);
     }
 
-    std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    // The file's size first (signature, IHDR, the IDATs, IEND): one
+    // allocation, not a growing vector's copies of the bands.
+    std::size_t file_bytes = 8 + 25 + 14 + 16 + 12;
+    for (const Band& band : bands) file_bytes += 12 + band.deflated.size();
+    std::vector<std::uint8_t> png;
+    png.reserve(file_bytes);
+    png.insert(png.end(), {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'});
     std::vector<std::uint8_t> ihdr;
     put_u32(ihdr, std::uint32_t(width));
     put_u32(ihdr, std::uint32_t(height));

@@ -92,8 +92,10 @@ int open_regular_file(const std::string& path, const std::string& name_in, std::
     return fd;
 }
 
-std::vector<unsigned char> read_regular_file(const std::string& path, std::uint64_t max_bytes,
-                                             const std::string& name_in) {
+namespace {
+
+template <class Bytes>
+void read_whole_file(const std::string& path, std::uint64_t max_bytes, const std::string& name_in, Bytes& bytes) {
     const std::string name = printable(name_in.empty() ? path : name_in);
     std::uint64_t size = 0;
     const int fd = open_regular_file(path, name_in, size);
@@ -107,7 +109,7 @@ std::vector<unsigned char> read_regular_file(const std::string& path, std::uint6
     if (size > max_bytes)
         throw LoadError(name + ": file too large (" + std::to_string(size) + " bytes; the limit is " +
                         std::to_string(max_bytes) + ")");
-    std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+    bytes.assign(static_cast<std::size_t>(size), 0);
     std::size_t got = 0;
     while (got < bytes.size()) {
         const ssize_t n = ::read(fd, bytes.data() + got, bytes.size() - got);
@@ -116,7 +118,19 @@ std::vector<unsigned char> read_regular_file(const std::string& path, std::uint6
         if (n == 0) throw LoadError(name + ": read error (the file shrank while being read)");
         got += std::size_t(n);
     }
+}
+
+} // namespace
+
+std::vector<unsigned char> read_regular_file(const std::string& path, std::uint64_t max_bytes,
+                                             const std::string& name) {
+    std::vector<unsigned char> bytes;
+    read_whole_file(path, max_bytes, name, bytes);
     return bytes;
+}
+
+void read_regular_file(const std::string& path, std::uint64_t max_bytes, const std::string& name, HugeBytes& out) {
+    read_whole_file(path, max_bytes, name, out);
 }
 
 FileScope::FileScope(const std::string& model, bool allow_outside) : model_(model), allow_outside_(allow_outside) {

@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "scene/huge_pages.h"
+
 namespace prast {
 
 // No single file is read past this (2 GiB; stb_image and tinygltf take int
@@ -42,6 +44,8 @@ int open_regular_file(const std::string& path, const std::string& name, std::uin
 // escaped for printing).
 std::vector<unsigned char> read_regular_file(const std::string& path, std::uint64_t max_bytes = kMaxReadBytes,
                                              const std::string& name = "");
+// The same into `out`, on huge pages where large (scene/huge_pages.h).
+void read_regular_file(const std::string& path, std::uint64_t max_bytes, const std::string& name, HugeBytes& out);
 
 // What a model may read: its folder and the references resolved so far.
 class FileScope {

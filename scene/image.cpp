@@ -359,7 +359,7 @@ bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h
         if (std::memcmp(data + pos + 4, "IDAT", 4) == 0) idat_bytes += len;
         pos += 12 + std::size_t(len);
     }
-    std::vector<unsigned char> compressed;
+    HugeBytes compressed;
     compressed.reserve(idat_bytes);
     for (std::size_t pos = 8; pos + 12 <= size;) {
         const std::uint32_t len = be32(data + pos);
@@ -391,7 +391,7 @@ bool inflate_png_whole(const unsigned char* data, std::size_t size, int w, int h
                                          raw_size, &in_used, &out_made) != LIBDEFLATE_SUCCESS ||
         out_made != raw_size)
         return false;
-    compressed = {};
+    compressed = HugeBytes();
     return unfilter_rows(raw, img.pixels.data(), stride, 0, h, channels) < 0;
 }
 
@@ -923,13 +923,19 @@ Image decode_image(const ImageSource& src, bool srgb, PixelCapacity capacity) {
                                        : !src.path.empty() ? src.path
                                                            : std::string("<embedded image>"));
     // Get the encoded bytes: embedded ones win over the path.
-    std::vector<unsigned char> file_bytes;
-    const std::vector<unsigned char>* bytes = &src.bytes;
+    HugeBytes file_bytes;
+    struct View {
+        const unsigned char* p;
+        std::size_t n;
+        const unsigned char* data() const { return p; }
+        std::size_t size() const { return n; }
+    } view{src.bytes.data(), src.bytes.size()};
+    const View* bytes = &view;
     if (src.bytes.empty()) {
         if (src.path.empty()) throw LoadError(name + ": no image data (no path, no bytes)");
         // Only a regular file, never past what stb_image's int length takes.
-        file_bytes = read_regular_file(src.path, std::uint64_t(INT_MAX), name);
-        bytes = &file_bytes;
+        read_regular_file(src.path, std::uint64_t(INT_MAX), name, file_bytes);
+        view = {file_bytes.data(), file_bytes.size()};
     }
     if (bytes->size() > std::size_t(INT_MAX)) throw LoadError(name + ": image data too large");
     const stbi_uc* data = bytes->data();

@@ -15,9 +15,22 @@
 #include <immintrin.h>
 #endif
 
+#include "scene/huge_pages.h"
 #include "shading/color.h"
 
 namespace prast {
+
+Rgba8Buffer::Rgba8Buffer(std::size_t pixels) {
+    if (!pixels) return;
+    if (pixels > (SIZE_MAX - 63) / 4) throw std::bad_alloc();
+    const std::size_t bytes = pixels * 4 + 63;
+    store_.reset(static_cast<std::uint8_t*>(allocate_huge(bytes)));
+    std::memset(store_.get(), 0, bytes);
+    const std::uintptr_t at = reinterpret_cast<std::uintptr_t>(store_.get());
+    data_ = store_.get() + ((64 - (at & 63)) & 63);
+}
+
+void Rgba8Buffer::Free::operator()(std::uint8_t* p) const noexcept { free_huge(p); }
 
 namespace {
 

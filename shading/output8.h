@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include "raster/frame.h"
@@ -28,22 +29,25 @@ void resolve_pixels_raw8(const float* rgba, std::size_t count, std::uint8_t* out
 // streams whole lines (a partly streamed line is flushed in pieces).
 class Rgba8Buffer {
 public:
-    explicit Rgba8Buffer(std::size_t pixels) : store_(pixels ? pixels * 4 + 63 : 0) {
-        if (pixels) {
-            const std::uintptr_t at = reinterpret_cast<std::uintptr_t>(store_.data());
-            data_ = store_.data() + ((64 - (at & 63)) & 63);
-        }
+    // Zeroed; on huge pages where large (scene/huge_pages.h): an image of
+    // 1920x1080 is otherwise some 2,000 page faults before the first pixel.
+    explicit Rgba8Buffer(std::size_t pixels);
+    Rgba8Buffer(Rgba8Buffer&& o) noexcept : store_(std::move(o.store_)), data_(o.data_) { o.data_ = nullptr; }
+    Rgba8Buffer& operator=(Rgba8Buffer&& o) noexcept {
+        store_ = std::move(o.store_);
+        data_ = o.data_;
+        o.data_ = nullptr;
+        return *this;
     }
-    Rgba8Buffer(const Rgba8Buffer&) = delete;  // data_ points into store_
-    Rgba8Buffer& operator=(const Rgba8Buffer&) = delete;
-    Rgba8Buffer(Rgba8Buffer&&) = default;      // the vector's memory moves along
-    Rgba8Buffer& operator=(Rgba8Buffer&&) = default;
 
     std::uint8_t* data() { return data_; }  // null for 0 pixels
     const std::uint8_t* data() const { return data_; }
 
 private:
-    std::vector<std::uint8_t> store_;
+    struct Free {
+        void operator()(std::uint8_t* p) const noexcept;
+    };
+    std::unique_ptr<std::uint8_t[], Free> store_;
     std::uint8_t* data_ = nullptr;
 };
 

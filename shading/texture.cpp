@@ -12,14 +12,12 @@
 #include <stdexcept>
 #include <string>
 
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
 #if defined(__SSSE3__)
 #include <immintrin.h>
 #endif
 
 #include "scene/det_math.h"
+#include "scene/huge_pages.h"
 #include "raster/thread_pool.h"
 #include "shading/isa.h"
 
@@ -381,24 +379,10 @@ void encode_codes(const std::uint8_t* bytes, std::uint16_t* out, std::size_t t0,
         for (int c = 0; c < C; ++c) o[c] = table[c][in[c]];
 }
 
-// Uninitialised memory for the 8-bit texels: large buffers are 2 MiB aligned
-// and advised as huge pages, so that filling them faults a few times, not
-// once per 4 KiB.
-std::uint8_t* allocate_texels(std::size_t bytes) {
-    constexpr std::size_t kHuge = std::size_t(2) << 20;
-    if (bytes >= kHuge) {
-        const std::size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
-        void* p = std::aligned_alloc(kHuge, rounded);
-        if (!p) throw std::bad_alloc();
-#ifdef MADV_HUGEPAGE
-        madvise(p, rounded, MADV_HUGEPAGE);
-#endif
-        return static_cast<std::uint8_t*>(p);
-    }
-    void* p = std::malloc(bytes);
-    if (!p) throw std::bad_alloc();
-    return static_cast<std::uint8_t*>(p);
-}
+// Uninitialised memory for the 8-bit texels, on huge pages where large
+// (filling them then faults a few times, not once per 4 KiB); freed with
+// std::free, which free_huge() is.
+std::uint8_t* allocate_texels(std::size_t bytes) { return static_cast<std::uint8_t*>(allocate_huge(bytes)); }
 
 // The 15-bit codes of the fixed-point filter (texture.h): linear bytes b * 128;
 // sRGB bytes the exact decode (in double) * 32640, rounded to nearest. Two

@@ -67,6 +67,7 @@ TEST_CASE("encoded PNGs decode to exactly the input pixels") {
                     o.band_rows = rows;
                     const std::vector<std::uint8_t> png = encode_png_pixels(px.data(), s[0], s[1], channels, o);
                     REQUIRE(decode_exact(png, s[0], s[1], channels) == px);
+                    CHECK(png.capacity() == png.size());  // the file's size worked out exactly, one allocation
                 }
         }
 }

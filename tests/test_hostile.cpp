@@ -459,6 +459,39 @@ TEST_CASE("FIFOs are never opened: buffer, image, mtllib, map and the model itse
           }) == 0);
 }
 
+TEST_CASE("the huge-page reader gives the vector reader's bytes and its messages") {
+    prast::test::TempDir dir("huge_read");
+    // Across 2 MiB (allocate_huge's aligned, rounded case) and below it.
+    for (std::size_t n : {std::size_t(1), std::size_t(4097), (std::size_t(2) << 20) + 12345}) {
+        std::vector<unsigned char> bytes(n);
+        std::uint32_t x = 12345u + std::uint32_t(n);
+        for (unsigned char& b : bytes) b = (x = x * 1664525u + 1013904223u) >> 24;
+        const std::string path = dir.file("f" + std::to_string(n));
+        prast::test::write_bytes(path, bytes);
+        HugeBytes huge;
+        read_regular_file(path, kMaxReadBytes, "", huge);
+        CHECK(std::vector<unsigned char>(huge.begin(), huge.end()) == bytes);
+        CHECK(read_regular_file(path) == bytes);
+        if (n >= (std::size_t(2) << 20))
+            CHECK(reinterpret_cast<std::uintptr_t>(huge.data()) % (std::uintptr_t(2) << 20) == 0);
+    }
+    prast::test::write_bytes(dir.file("empty"), {});
+    const auto message = [](auto&& read) {
+        try {
+            read();
+        } catch (const LoadError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    HugeBytes huge;
+    CHECK(message([&] { read_regular_file(dir.file("empty"), kMaxReadBytes, "e", huge); }) == "e: empty file");
+    CHECK(message([&] { read_regular_file(dir.file("f4097"), 4096, "big", huge); }) ==
+          "big: file too large (4097 bytes; the limit is 4096)");
+    CHECK(message([&] { read_regular_file(dir.file("f4097"), 4096, "big"); }) ==
+          message([&] { read_regular_file(dir.file("f4097"), 4096, "big", huge); }));
+}
+
 // ---------------------------------------------------------------- limits
 
 TEST_CASE("a truncated run-length .hdr (CVE-2021-42715 in stb_image 2.27) is refused before stb sees it") {

@@ -308,3 +308,21 @@ TEST_CASE("the eight-lane sRGB encoder equals the scalar encoder over [0, 1]") {
     CHECK(bits.size() > 4000000);
     CHECK(mismatches == 0);
 }
+
+TEST_CASE("Rgba8Buffer: zeroed, cache-line aligned, movable") {
+    for (std::size_t pixels : {std::size_t(1), std::size_t(17), std::size_t(1920) * 1080}) {
+        Rgba8Buffer b(pixels);
+        REQUIRE(b.data() != nullptr);
+        CHECK(reinterpret_cast<std::uintptr_t>(b.data()) % 64 == 0);
+        std::size_t nonzero = 0;
+        for (std::size_t i = 0; i < pixels * 4; ++i) nonzero += b.data()[i] != 0;
+        CHECK(nonzero == 0);
+        b.data()[pixels * 4 - 1] = 7;
+        Rgba8Buffer moved(std::move(b));
+        CHECK(b.data() == nullptr);
+        CHECK(moved.data()[pixels * 4 - 1] == 7);
+        b = std::move(moved);
+        CHECK(b.data()[pixels * 4 - 1] == 7);
+    }
+    CHECK(Rgba8Buffer(0).data() == nullptr);
+}
