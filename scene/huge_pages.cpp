@@ -28,4 +28,14 @@ void* allocate_huge(std::size_t bytes) {
 
 void free_huge(void* p) noexcept { std::free(p); }
 
+void reserve_huge(std::vector<std::uint8_t>& v, std::size_t n) {
+    v.reserve(n);
+#ifdef MADV_HUGEPAGE
+    constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+    const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
+    const std::uintptr_t e = (reinterpret_cast<std::uintptr_t>(v.data()) + v.capacity()) & ~(kHuge - 1);
+    if (e > b) madvise(reinterpret_cast<void*>(b), e - b, MADV_HUGEPAGE);
+#endif
+}
+
 } // namespace prast

@@ -30,14 +30,12 @@
 #include <stb_image.h>
 #include <turbojpeg.h>
 #include <webp/decode.h>
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
 #include <unistd.h>
 
 #include "scene/det_math.h"
 #include "scene/file_access.h"
 #include "scene/hdr_guard.h"
+#include "scene/huge_pages.h"
 #include "scene/messages.h"
 
 namespace prast {
@@ -317,19 +315,6 @@ int unfilter_rows(const unsigned char* raw, unsigned char* pixels, std::size_t n
         ++y;
     }
     return -1;
-}
-
-// Reserves n bytes for v, on transparent huge pages where the kernel offers
-// them on request (THP "madvise" mode): a 2048x2048 RGB map's buffer is
-// otherwise ~3,000 page faults, which cost more than inflating it.
-void reserve_huge(std::vector<std::uint8_t>& v, std::size_t n) {
-    v.reserve(n);
-#ifdef MADV_HUGEPAGE
-    constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
-    const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
-    const std::uintptr_t e = (reinterpret_cast<std::uintptr_t>(v.data()) + v.capacity()) & ~(kHuge - 1);
-    if (e > b) madvise(reinterpret_cast<void*>(b), e - b, MADV_HUGEPAGE);
-#endif
 }
 
 // The zlib header (RFC 1950) of a PNG's image data: deflate, a window of at
