@@ -816,6 +816,47 @@ TEST_CASE("fill rule: random triangles on the half-pixel lattice match the top-l
     CHECK(mismatches == 0);
 }
 
+TEST_CASE("fill rule: long triangles (edges to 2,000 px, far from the view) match the top-left rule exactly") {
+    // One vertex near the 64x64 view, two up to 1,000 px away: edge values at
+    // the view's blocks reach 2^36 and more (beyond 32 bits), the blocks'
+    // classifications meet long edges at every angle, and most edges stay
+    // under 2,048 px in |dx| + |dy|, a few beyond.
+    const int W = 64, H = 64;
+    Random rng(4242);
+    int narrow = 0, wide = 0, covered = 0, mismatches = 0;
+    for (int split = 0; split < 2; ++split) {
+        Renderer r(RendererOptions{1 + split, split ? 16 : 64});
+        for (int i = 0; i < 150; ++i) {
+            glm::dvec2 v[3];
+            v[0] = {rng.below(2 * (W + 16)) * 0.5 - 8.0, rng.below(2 * (H + 16)) * 0.5 - 8.0};
+            for (int k = 1; k < 3; ++k) v[k] = {rng.below(4128) * 0.5 - 1000.0, rng.below(4128) * 0.5 - 1000.0};
+            const double area = (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[2].x - v[0].x) * (v[1].y - v[0].y);
+            if (area == 0) continue;
+            double longest = 0;
+            for (int e = 0; e < 3; ++e)
+                longest = std::max(longest, std::abs(v[(e + 1) % 3].x - v[e].x) + std::abs(v[(e + 1) % 3].y - v[e].y));
+            (longest <= 2048 ? narrow : wide) += 1;
+            WinTris t{W, H, {}, {}};
+            t.add(v[0], v[1], v[2]);
+            const std::vector<int> c = draw_counts(r, W, H, t.clip, t.idx, CullMode::None);
+            for (int y = 0; y < H; ++y)
+                for (int x = 0; x < W; ++x) {
+                    const bool expect = spec_covers(v, x + 0.5, y + 0.5);
+                    const int got = c[std::size_t(y) * W + x];
+                    covered += got == 1;
+                    if (got != (expect ? 1 : 0) && ++mismatches <= 5)
+                        MESSAGE("triangle (" << v[0].x << "," << v[0].y << ") (" << v[1].x << "," << v[1].y << ") ("
+                                             << v[2].x << "," << v[2].y << ") pixel " << x << "," << y << " got "
+                                             << got << " expected " << expect);
+                }
+        }
+    }
+    CHECK(mismatches == 0);
+    CHECK(narrow > 150);
+    CHECK(wide > 10);
+    CHECK(covered > 100000);
+}
+
 TEST_CASE("setup: the vectorised set-up equals the portable one field for field") {
     // Window positions at four scales (a pixel, the screen, the guard band,
     // its limit 2^29 / 256 px), both windings, culling on and off, one
