@@ -112,8 +112,16 @@ void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, cons
     // Sets up one (piece of a) triangle and bins it. Counting is left to the
     // caller, so that a clipped triangle counts once however many pieces it has.
     // Unclipped triangles use the vertex pass's projections (`window`).
-    auto accept = [&](TriangleSetup& t, SetupResult r, std::uint32_t prim,
-                      bool clipped) __attribute__((always_inline)) -> SetupResult {
+    auto emit = [&](const float* const clip[3], const std::uint32_t ref[3], std::uint32_t prim,
+                    bool clipped) __attribute__((always_inline)) -> SetupResult {
+        TriangleSetup t;
+        SetupResult r;
+        if (clipped) {
+            r = setup_triangle(clip, ref, grid.width, grid.height, cull_back, t, samples);
+        } else {
+            const WindowVertex* const v[3] = {&window[ref[0]], &window[ref[1]], &window[ref[2]]};
+            r = setup_triangle(v, ref, grid.width, grid.height, cull_back, t, samples);
+        }
         if (r == SetupResult::CulledBack) {
             if constexpr (Observer::enabled) obs.triangle(prim, TriangleFate::CulledBack, clipped, nullptr);
             return r;
@@ -133,41 +141,9 @@ void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, cons
         });
         return r;
     };
-    auto emit = [&](const float* const clip[3], const std::uint32_t ref[3], std::uint32_t prim,
-                    bool clipped) __attribute__((always_inline)) -> SetupResult {
-        TriangleSetup t;
-        SetupResult r;
-        if (clipped) {
-            r = setup_triangle(clip, ref, grid.width, grid.height, cull_back, t, samples);
-        } else {
-            const WindowVertex* const v[3] = {&window[ref[0]], &window[ref[1]], &window[ref[2]]};
-            r = setup_triangle(v, ref, grid.width, grid.height, cull_back, t, samples);
-        }
-        return accept(t, r, prim, clipped);
-    };
     auto count = [&](bool any_setup, bool any_back) {
         if (any_back) ++st.triangles_culled_back;
         else if (!any_setup) ++st.triangles_degenerate;
-    };
-    // Unclipped triangles are set up four at a time where that is faster
-    // (setup_triangles4), and accepted in their order before any later
-    // triangle's pieces; with an observer, one at a time in its order of
-    // events.
-    constexpr bool kFour = kSetupFourAtOnce && !Observer::enabled;
-    const WindowVertex* four_v[12];
-    std::uint32_t four_ref[12], four_prim[4];
-    int four_n = 0, front_run = 0;
-    auto flush_four = [&]() {
-        if (!four_n) return;
-        TriangleSetup t[4];
-        SetupResult r[4];
-        setup_triangles4(four_v, four_ref, four_n, grid.width, grid.height, cull_back, samples, t, r);
-        for (int k = 0; k < four_n; ++k) {
-            accept(t[k], r[k], four_prim[k], false);
-            count(r[k] == SetupResult::Ok, r[k] == SetupResult::CulledBack);
-            if (r[k] == SetupResult::CulledBack) front_run = 0;
-        }
-        four_n = 0;
     };
 
     for (std::size_t tri = tri_begin; tri < tri_end; ++tri) {
@@ -198,37 +174,11 @@ void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, cons
         }
         std::uint32_t planes = (oc0 | oc1 | oc2) & kClipNeededBits;
         if (!planes) {
-            if constexpr (kFour) {
-                // A back face is culled here, as setup_triangle() would
-                // (CulledBack: valid vertices, a positive area), so that a
-                // closed mesh's back half takes no lanes of the set-up.
-                // After 64 front faces in a row this test stops until the
-                // set-up culls a face again (either way the same results).
-                if (cull_back && front_run < 64) {
-                    const WindowVertex &a = window[ref[0]], &b = window[ref[1]], &c = window[ref[2]];
-                    if ((a.ok & b.ok & c.ok) &&
-                        (std::int64_t(b.x) - a.x) * (std::int64_t(c.y) - a.y) -
-                                (std::int64_t(c.x) - a.x) * (std::int64_t(b.y) - a.y) > 0) {
-                        front_run = 0;
-                        count(false, true);
-                        continue;
-                    }
-                    ++front_run;
-                }
-                for (int i = 0; i < 3; ++i) {
-                    four_v[3 * four_n + i] = &window[ref[i]];
-                    four_ref[3 * four_n + i] = ref[i];
-                }
-                four_prim[four_n] = prim;
-                if (++four_n == 4) flush_four();
-            } else {
-                SetupResult r = emit(clip, ref, prim, false);
-                count(r == SetupResult::Ok, r == SetupResult::CulledBack);
-            }
+            SetupResult r = emit(clip, ref, prim, false);
+            count(r == SetupResult::Ok, r == SetupResult::CulledBack);
             continue;
         }
         // Clip; the polygon's vertices go to this job's pool and the pieces are a fan.
-        flush_four();
         ++st.triangles_clipped;
         int n = clip_triangle(clip, stride, planes, gb, polygon);
         bool positive_w = n >= 3;
@@ -254,7 +204,6 @@ void bin_triangles(BinJob& job, std::size_t tri_begin, std::size_t tri_end, cons
         }
         count(any_setup, any_back);
     }
-    flush_four();
 }
 
 // Appends the tiles that line or point `index` of `job` may cover to

@@ -61,19 +61,6 @@ SetupResult setup_triangle(const WindowVertex* const v[3], const std::uint32_t r
 SetupResult setup_triangle_scalar(const WindowVertex* const v[3], const std::uint32_t ref[3], int width, int height,
                                   bool cull_back, TriangleSetup& t, const SampleExtent& samples);
 
-// setup_triangle() for n (1 to 4) triangles at once, triangle k's vertices
-// v[3k .. 3k + 2] and references ref[3k .. 3k + 2]: result[k] and, where it
-// is Ok, out[k] (its prim_id left to the caller) are what setup_triangle()
-// gives, byte for byte. Under AVX2 the four run in the lanes of each
-// operation; elsewhere it is setup_triangle() four times.
-void setup_triangles4(const WindowVertex* const* v, const std::uint32_t* ref, int n, int width, int height,
-                      bool cull_back, const SampleExtent& samples, TriangleSetup* out, SetupResult* result);
-#if defined(__AVX2__)
-constexpr bool kSetupFourAtOnce = true;
-#else
-constexpr bool kSetupFourAtOnce = false;
-#endif
-
 // clip[i] points at the clip-space xyzw of vertex i (w > 0, within the guard band).
 // `samples` widens the pixel box to the pixels any sample of which may be
 // covered (the default, one sample at the centre, gives the centre box).

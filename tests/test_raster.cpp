@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -858,7 +857,7 @@ TEST_CASE("fill rule: long triangles (edges to 2,000 px, far from the view) matc
     CHECK(covered > 100000);
 }
 
-TEST_CASE("setup: the vectorised set-ups (one and four at once) equal the portable one field for field") {
+TEST_CASE("setup: the vectorised set-up equals the portable one field for field") {
     // Window positions at four scales (a pixel, the screen, the guard band,
     // its limit 2^29 / 256 px), both windings, culling on and off, one
     // sample and a four-sample extent: every result and every field equal.
@@ -896,36 +895,6 @@ TEST_CASE("setup: the vectorised set-ups (one and four at once) equal the portab
         const SetupResult ra = setup_triangle(v, ref, W, H, cull, a, ext);
         const SetupResult rb = setup_triangle_scalar(v, ref, W, H, cull, b, ext);
         REQUIRE(ra == rb);
-        // The four-at-once set-up: this triangle in lane i % 4 of a batch of
-        // (i % 4) + 1, the lanes before it filled with other triangles.
-        {
-            const int lane = i % 4;
-            WindowVertex others[3][3];
-            const WindowVertex* batch_v[12];
-            std::uint32_t batch_ref[12];
-            for (int k = 0; k < lane; ++k)
-                for (int j = 0; j < 3; ++j) {
-                    others[k][j] = wv[(j + k + 1) % 3];
-                    others[k][j].x += std::int32_t(rng.below(4096)) - 2048;
-                    batch_v[3 * k + j] = &others[k][j];
-                    batch_ref[3 * k + j] = std::uint32_t(rng.below(1000));
-                }
-            for (int j = 0; j < 3; ++j) {
-                batch_v[3 * lane + j] = v[j];
-                batch_ref[3 * lane + j] = ref[j];
-            }
-            TriangleSetup four[4];
-            SetupResult four_r[4];
-            setup_triangles4(batch_v, batch_ref, lane + 1, W, H, cull, ext, four, four_r);
-            REQUIRE(four_r[lane] == rb);
-            if (rb == SetupResult::Ok) {
-                four[lane].prim_id = b.prim_id;
-                if (std::memcmp(&four[lane], &b, offsetof(TriangleSetup, front_facing)) != 0 ||
-                    four[lane].front_facing != b.front_facing) {
-                    if (++mismatches <= 5) MESSAGE("triangle " << i << " sets up differently four at once");
-                }
-            }
-        }
         if (ra == SetupResult::CulledBack) ++culled;
         if (ra == SetupResult::Degenerate) ++degenerate;
         if (ra != SetupResult::Ok) continue;
