@@ -56,11 +56,6 @@ WindowVertex window_vertex(const float* clip, int width, int height);
 SetupResult setup_triangle(const WindowVertex* const v[3], const std::uint32_t ref[3], int width, int height,
                            bool cull_back, TriangleSetup& t, const SampleExtent& samples);
 
-// The same, always with the portable code, whatever the build: what the
-// vectorised set-up of an AVX2 build must equal field for field (tests).
-SetupResult setup_triangle_scalar(const WindowVertex* const v[3], const std::uint32_t ref[3], int width, int height,
-                                  bool cull_back, TriangleSetup& t, const SampleExtent& samples);
-
 // clip[i] points at the clip-space xyzw of vertex i (w > 0, within the guard band).
 // `samples` widens the pixel box to the pixels any sample of which may be
 // covered (the default, one sample at the centre, gives the centre box).

@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <mutex>
@@ -855,75 +854,6 @@ TEST_CASE("fill rule: long triangles (edges to 2,000 px, far from the view) matc
     CHECK(narrow > 150);
     CHECK(wide > 10);
     CHECK(covered > 100000);
-}
-
-TEST_CASE("setup: the vectorised set-up equals the portable one field for field") {
-    // Window positions at four scales (a pixel, the screen, the guard band,
-    // its limit 2^29 / 256 px), both windings, culling on and off, one
-    // sample and a four-sample extent: every result and every field equal.
-    Random rng(77);
-    const int W = 1920, H = 1080;
-    SampleExtent four;
-    four.lo_x = -96; four.hi_x = 96; four.lo_y = -96; four.hi_y = 96;
-    const std::int64_t limit = std::int64_t(1) << 29;
-    const std::int64_t scales[4] = {3 * kSubPixelScale, 2048 * kSubPixelScale, std::int64_t(1) << 28, limit};
-    int ok = 0, culled = 0, degenerate = 0, front = 0, biased = 0;
-    std::uint64_t mismatches = 0;
-    for (int i = 0; i < 200000; ++i) {
-        const std::int64_t scale = scales[i % 4];
-        const std::int64_t cx = std::int64_t(rng.below(W)) * kSubPixelScale, cy = std::int64_t(rng.below(H)) * kSubPixelScale;
-        WindowVertex wv[3];
-        for (WindowVertex& w : wv) {
-            auto coord = [&](std::int64_t c) {
-                const std::int64_t v = c + std::int64_t(rng.range(-1.0, 1.0) * double(scale));
-                return std::int32_t(std::clamp<std::int64_t>(v, -limit, limit));
-            };
-            w.x = coord(cx);
-            w.y = coord(cy);
-            // Some vertices on a shared lattice, for horizontal and vertical edges.
-            if (rng.below(4) == 0) w.x = std::int32_t(cx);
-            if (rng.below(4) == 0) w.y = std::int32_t(cy);
-            w.z = float(rng.uniform());
-            w.inv_w = float(rng.range(0.1, 10.0));
-            w.ok = rng.below(1000) != 0;
-        }
-        const WindowVertex* const v[3] = {&wv[0], &wv[1], &wv[2]};
-        const std::uint32_t ref[3] = {std::uint32_t(3 * i), std::uint32_t(3 * i + 1), std::uint32_t(3 * i + 2)};
-        const bool cull = rng.below(2) == 0;
-        const SampleExtent& ext = (i / 4) % 2 ? four : SampleExtent{};
-        TriangleSetup a{}, b{};
-        const SetupResult ra = setup_triangle(v, ref, W, H, cull, a, ext);
-        const SetupResult rb = setup_triangle_scalar(v, ref, W, H, cull, b, ext);
-        REQUIRE(ra == rb);
-        if (ra == SetupResult::CulledBack) ++culled;
-        if (ra == SetupResult::Degenerate) ++degenerate;
-        if (ra != SetupResult::Ok) continue;
-        ++ok;
-        front += a.front_facing;
-        bool same = a.minx == b.minx && a.miny == b.miny && a.maxx == b.maxx && a.maxy == b.maxy && a.ax == b.ax &&
-                    a.ay == b.ay && a.front_facing == b.front_facing &&
-                    std::memcmp(&a.area, &b.area, sizeof a.area) == 0;
-        for (int e = 0; e < 3; ++e) {
-            same = same && a.A[e] == b.A[e] && a.B[e] == b.B[e] && a.C[e] == b.C[e] && a.vtx[e] == b.vtx[e] &&
-                   std::memcmp(&a.z[e], &b.z[e], sizeof(float)) == 0 &&
-                   std::memcmp(&a.inv_w[e], &b.inv_w[e], sizeof(float)) == 0 &&
-                   std::memcmp(a.bary[e], b.bary[e], sizeof a.bary[e]) == 0;
-            // Edges that are neither top nor left: their C carries the rule's -1.
-            biased += !(b.A[e] > 0 || (b.A[e] == 0 && b.B[e] > 0));
-        }
-        if (!same && ++mismatches <= 5)
-            MESSAGE("triangle " << i << ": (" << wv[0].x << "," << wv[0].y << ") (" << wv[1].x << "," << wv[1].y
-                                << ") (" << wv[2].x << "," << wv[2].y << ") sets up differently");
-    }
-#if !defined(__AVX2__)
-    MESSAGE("this build has no AVX2 set-up: setup_triangle is the portable code itself");
-#endif
-    CHECK(mismatches == 0);
-    CHECK(ok > 100000);
-    CHECK(culled > 20000);
-    CHECK(degenerate > 1000);
-    CHECK(front > 20000);
-    CHECK(biased > 10000);
 }
 
 // ===========================================================================
