@@ -381,7 +381,7 @@ void encode_codes(const std::uint8_t* bytes, std::uint16_t* out, std::size_t t0,
 
 // Uninitialised memory for the 8-bit texels, on huge pages where large
 // (filling them then faults a few times, not once per 4 KiB); freed with
-// std::free, which free_huge() is.
+// free_huge() (Texture::FreeBytes, CodeCache::Free).
 std::uint8_t* allocate_texels(std::size_t bytes) { return static_cast<std::uint8_t*>(allocate_huge(bytes)); }
 
 // The 15-bit codes of the fixed-point filter (texture.h): linear bytes b * 128;
@@ -539,8 +539,8 @@ Texture Texture::from_image(Image img, Wrap s, Wrap t, ThreadPool* pool) {
 }
 
 struct CodeCache {
-    struct Free {
-        void operator()(std::uint8_t* p) const { std::free(p); }
+    struct Free {  // of allocate_texels()
+        void operator()(std::uint8_t* p) const noexcept { free_huge(p); }
     };
     std::unique_ptr<std::uint8_t[], Free> buffer;
     std::atomic<std::uint32_t> ready{0};  // bit l: level l is filled
@@ -621,6 +621,8 @@ Texture Texture::from_unorm8(const std::uint8_t* level0, int channels, const boo
     tex.storage_ = std::move(st);
     return tex;
 }
+
+void Texture::FreeBytes::operator()(std::uint8_t* p) const noexcept { free_huge(p); }
 
 Texture::Storage::Storage() = default;
 Texture::Storage::~Storage() = default;

@@ -283,8 +283,8 @@ private:
                                int w, int h, Wrap s, Wrap t, ThreadPool* pool,
                                std::vector<std::uint8_t>* adopt = nullptr);
 
-    struct FreeBytes {
-        void operator()(std::uint8_t* p) const { std::free(p); }
+    struct FreeBytes {  // for the 8-bit storage's buffers (allocated on huge pages where large)
+        void operator()(std::uint8_t* p) const noexcept;
     };
     // The texels, shared by every view of one decoded image.
     struct Storage {
