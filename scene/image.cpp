@@ -909,33 +909,28 @@ Image decode_image(const ImageSource& src, bool srgb, PixelCapacity capacity) {
                                                            : std::string("<embedded image>"));
     // Get the encoded bytes: embedded ones win over the path.
     HugeBytes file_bytes;
-    struct View {
-        const unsigned char* p;
-        std::size_t n;
-        const unsigned char* data() const { return p; }
-        std::size_t size() const { return n; }
-    } view{src.bytes.data(), src.bytes.size()};
-    const View* bytes = &view;
+    const stbi_uc* data = src.bytes.data();
+    std::size_t size = src.bytes.size();
     if (src.bytes.empty()) {
         if (src.path.empty()) throw LoadError(name + ": no image data (no path, no bytes)");
         // Only a regular file, never past what stb_image's int length takes.
         read_regular_file(src.path, std::uint64_t(INT_MAX), name, file_bytes);
-        view = {file_bytes.data(), file_bytes.size()};
+        data = file_bytes.data();
+        size = file_bytes.size();
     }
-    if (bytes->size() > std::size_t(INT_MAX)) throw LoadError(name + ": image data too large");
-    const stbi_uc* data = bytes->data();
-    const int len = int(bytes->size());
+    if (size > std::size_t(INT_MAX)) throw LoadError(name + ": image data too large");
+    const int len = int(size);
 
-    if (is_webp(data, bytes->size())) {
+    if (is_webp(data, size)) {
         // Its header's size is checked before libwebp allocates anything.
         Image img;
-        const std::string refused = webp_header(data, bytes->size(), bytes->size(), img.width, img.height, img.channels);
+        const std::string refused = webp_header(data, size, size, img.width, img.height, img.channels);
         if (!refused.empty()) throw LoadError(name + ": " + refused);
         const std::size_t row = std::size_t(img.width) * std::size_t(img.channels);
         img.pixels.resize(row * std::size_t(img.height));
         const std::uint8_t* ok = img.channels == 4
-            ? WebPDecodeRGBAInto(data, bytes->size(), img.pixels.data(), img.pixels.size(), int(row))
-            : WebPDecodeRGBInto(data, bytes->size(), img.pixels.data(), img.pixels.size(), int(row));
+            ? WebPDecodeRGBAInto(data, size, img.pixels.data(), img.pixels.size(), int(row))
+            : WebPDecodeRGBInto(data, size, img.pixels.data(), img.pixels.size(), int(row));
         if (!ok) throw LoadError(name + ": cannot decode WebP image: corrupt or truncated data");
         img.srgb = srgb;
         return img;
@@ -943,18 +938,18 @@ Image decode_image(const ImageSource& src, bool srgb, PixelCapacity capacity) {
 
     // Through the guard first: stb_image 2.27 can hang on Radiance data
     // (scene/hdr_guard.h).
-    const std::string unsafe = stb_unsafe(data, bytes->size());
+    const std::string unsafe = stb_unsafe(data, size);
     if (!unsafe.empty()) throw LoadError(name + ": " + unsafe);
 
     // Check the header before decoding anything: refuse absurd sizes up front.
     ImageHeader header;
-    const std::string refused = read_image_header(data, bytes->size(), bytes->size(), header);
+    const std::string refused = read_image_header(data, size, size, header);
     if (!refused.empty()) throw LoadError(name + ": " + refused);
     const int w = header.width, h = header.height;
     const std::int64_t texels = std::int64_t(w) * std::int64_t(h);
 
-    if (is_png(data, bytes->size())) {
-        const std::string shortfall = png_data_shortfall(data, bytes->size(), w, h);
+    if (is_png(data, size)) {
+        const std::string shortfall = png_data_shortfall(data, size, w, h);
         if (!shortfall.empty()) throw LoadError(name + ": cannot decode PNG image: " + shortfall);
     }
 
@@ -966,7 +961,7 @@ Image decode_image(const ImageSource& src, bool srgb, PixelCapacity capacity) {
     int dw = 0, dh = 0, dcomp = 0;
     auto check = [&](const void* pixels) {
         if (!pixels) {
-            const char* format = sniff_format(data, bytes->size());
+            const char* format = sniff_format(data, size);
             throw LoadError(name + ": cannot decode " + (format ? format : "") + (format ? " " : "") +
                             "image: " + stbi_reason());
         }
@@ -980,7 +975,7 @@ Image decode_image(const ImageSource& src, bool srgb, PixelCapacity capacity) {
     if (header.png_by_ihdr && header.sixteen_bit) {
         std::vector<std::uint16_t> values;
         int channels = 0;
-        PngSource png{data, bytes->size(), 0, {0}};
+        PngSource png{data, size, 0, {0}};
         if (!decode_png16(png, w, h, values, channels))
             throw LoadError(name + ": cannot decode PNG image: " + png.error);
         img.width = w;
@@ -1006,18 +1001,18 @@ Image decode_image(const ImageSource& src, bool srgb, PixelCapacity capacity) {
         else expand_to_rgba(px.get(), dcomp, count, img.rgba.data(), linear, linear);
     } else if (header.jpeg) {
         if (capacity) reserve_huge(img.pixels, capacity(w, h, header.channels));
-        const std::string why = decode_jpeg(data, bytes->size(), header, img);
+        const std::string why = decode_jpeg(data, size, header, img);
         if (!why.empty()) throw LoadError(name + ": cannot decode JPEG image: " + why);
         img.srgb = srgb;
-    } else if (is_png(data, bytes->size())) {
+    } else if (is_png(data, size)) {
         // 8-bit PNG: the bytes as the file has them; sampling decodes them.
         std::string error;
         if (capacity) reserve_huge(img.pixels, capacity(w, h, header.channels));
-        const FastPng fast = decode_png_fast(data, bytes->size(), w, h, img, error);
+        const FastPng fast = decode_png_fast(data, size, w, h, img, error);
         if (fast == FastPng::Failed) throw LoadError(name + ": cannot decode PNG image: " + error);
         if (fast == FastPng::NotMine) {
             img = Image();
-            PngSource png{data, bytes->size(), 0, {0}};
+            PngSource png{data, size, 0, {0}};
             if (!decode_png8(png, w, h, img)) throw LoadError(name + ": cannot decode PNG image: " + png.error);
         }
         img.srgb = srgb;
