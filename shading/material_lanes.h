@@ -63,11 +63,18 @@ template <int N, class Isa = IsaDefault>
     }
 }
 
-// Copies and fills of lane arrays in whole 32-byte vectors where AVX2 is
-// on: a memcpy of 64 bytes compiled to 16-byte moves, and the vector loads
+// Copies and fills of lane arrays in whole vectors of the width the loops
+// that read them use (64 bytes in the AVX-512 copy, else 32 where AVX2 is
+// on): a memcpy of 64 bytes compiled to 16-byte moves, and the vector loads
 // that read the copy back stalled on store forwarding.
 template <int N, class Isa = IsaDefault>
 [[gnu::always_inline]] inline void copy_lanes(float* dst, const float* src) {
+#ifdef PRAST_SIMD16
+    if constexpr (N % 16 == 0) {
+        for (int l = 0; l < N; l += 16) _mm512_storeu_ps(dst + l, _mm512_loadu_ps(src + l));
+        return;
+    }
+#endif
 #ifdef __AVX2__
     if constexpr (N % 8 == 0) {
         for (int l = 0; l < N; l += 8) _mm256_storeu_ps(dst + l, _mm256_loadu_ps(src + l));
@@ -78,6 +85,12 @@ template <int N, class Isa = IsaDefault>
 }
 template <int N, class Isa = IsaDefault>
 [[gnu::always_inline]] inline void fill_lanes(float* dst, float v) {
+#ifdef PRAST_SIMD16
+    if constexpr (N % 16 == 0) {
+        for (int l = 0; l < N; l += 16) _mm512_storeu_ps(dst + l, _mm512_set1_ps(v));
+        return;
+    }
+#endif
 #ifdef __AVX2__
     if constexpr (N % 8 == 0) {
         for (int l = 0; l < N; l += 8) _mm256_storeu_ps(dst + l, _mm256_set1_ps(v));
