@@ -586,28 +586,41 @@ template <class V, int C, class Isa>
 #if defined(__AVX512VBMI__)
     if constexpr (std::is_same_v<Isa, IsaAvx512Vbmi> && (C == 3 || C == 4)) {
         if (pairs) {
-            I qa[2], qc[2], la[2] = {}, ha[2] = {}, lc[2] = {}, hc[2] = {};
+            I qa[2], qc[2];
             // A lane's two taps of a row (x0 and x1) are the qword read at x0.
             V::template gather_qwords<C>(base, idx[0] + l0, qa);
             V::template gather_qwords<C>(base, idx[2] + l0, qc);
-            if (needs_srgb) {
-                const SrgbCodeBytes& table = srgb_code_bytes<Isa>();
-                for (int k = 0; k < 2; ++k) {
-                    code_bytes<Isa>(qa[k], table, la[k], ha[k]);
-                    code_bytes<Isa>(qc[k], table, lc[k], hc[k]);
+            // Without an sRGB channel the code bytes are not made at all
+            // (zeroing them for nothing cost stores of eight registers).
+            auto rows = [&](auto srgb_tag) __attribute__((always_inline)) {
+                constexpr bool kSrgb = decltype(srgb_tag)::value;
+                I la[2], ha[2], lc[2], hc[2];
+                if constexpr (kSrgb) {
+                    const SrgbCodeBytes& table = srgb_code_bytes<Isa>();
+                    for (int k = 0; k < 2; ++k) {
+                        code_bytes<Isa>(qa[k], table, la[k], ha[k]);
+                        code_bytes<Isa>(qc[k], table, lc[k], hc[k]);
+                    }
                 }
-            }
-            auto channel = [&](auto cc) __attribute__((always_inline)) {
-                constexpr int c = decltype(cc)::value;
-                if (!((need >> c) & 1u)) return;
-                I top, bottom;
-                pair_rows_vbmi<Isa, C, c>(qa, qc, la, ha, lc, hc, srgb_codes[c] != nullptr, top, bottom);
-                result[c] = bilerp_pairs<V>(top, bottom, wx, wy);
+                auto channel = [&](auto cc) __attribute__((always_inline)) {
+                    constexpr int c = decltype(cc)::value;
+                    if (!((need >> c) & 1u)) return;
+                    I top, bottom;
+                    if constexpr (kSrgb) {
+                        pair_rows_vbmi<Isa, C, c>(qa, qc, la, ha, lc, hc, srgb_codes[c] != nullptr, top, bottom);
+                    } else {
+                        top = pair_linear<Isa, C, c>(qa);
+                        bottom = pair_linear<Isa, C, c>(qc);
+                    }
+                    result[c] = bilerp_pairs<V>(top, bottom, wx, wy);
+                };
+                channel(std::integral_constant<int, 0>());
+                channel(std::integral_constant<int, 1>());
+                channel(std::integral_constant<int, 2>());
+                if constexpr (C == 4) channel(std::integral_constant<int, 3>());
             };
-            channel(std::integral_constant<int, 0>());
-            channel(std::integral_constant<int, 1>());
-            channel(std::integral_constant<int, 2>());
-            if constexpr (C == 4) channel(std::integral_constant<int, 3>());
+            if (needs_srgb) rows(std::true_type());
+            else rows(std::false_type());
             return;
         }
     }
