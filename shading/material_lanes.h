@@ -31,14 +31,16 @@ struct SurfaceLanes {
     const float *Tx, *Ty, *Tz, *Tw; // tangent + handedness
     const float *u, *v;             // UV set 0
     const std::uint8_t* quad = nullptr;
-    float dudx[kMaxQuadSlots], dvdx[kMaxQuadSlots], dudy[kMaxQuadSlots], dvdy[kMaxQuadSlots];  // per quad
+    // Per quad slot; the one past kMaxQuadSlots takes the writes of quads
+    // without a live lane, which the packing makes without a branch.
+    float dudx[kMaxQuadSlots + 1], dvdx[kMaxQuadSlots + 1], dudy[kMaxQuadSlots + 1], dvdy[kMaxQuadSlots + 1];
     std::uint32_t back_facing = 0;  // lanes of back-facing triangles
     // UV sets 1 .. kMaxUvSets - 1 and their per-quad derivatives, filled only
     // when the material reads them (BoundMaterial::reads_extra_uv_sets).
     const float* u_more[kMaxUvSets - 1] = {};
     const float* v_more[kMaxUvSets - 1] = {};
-    float dudx_more[kMaxUvSets - 1][kMaxQuadSlots], dvdx_more[kMaxUvSets - 1][kMaxQuadSlots];
-    float dudy_more[kMaxUvSets - 1][kMaxQuadSlots], dvdy_more[kMaxUvSets - 1][kMaxQuadSlots];
+    float dudx_more[kMaxUvSets - 1][kMaxQuadSlots + 1], dvdx_more[kMaxUvSets - 1][kMaxQuadSlots + 1];
+    float dudy_more[kMaxUvSets - 1][kMaxQuadSlots + 1], dvdy_more[kMaxUvSets - 1][kMaxQuadSlots + 1];
     // The vertex colour (linear RGBA); null when the mesh has none.
     const float *Cr = nullptr, *Cg = nullptr, *Cb = nullptr, *Ca = nullptr;
 

@@ -249,12 +249,16 @@ void PbrProgramT<NV>::shade_packed(const FragmentBlock<kVaryings>* const* in, Fr
     for (int b = 0; b < count; ++b) {
         const FragmentBlock<kVaryings>& B = *in[b];
         std::uint32_t slot_of = 0;  // byte q: quad q's slot
+        // Without branches (which quads are live is a coin toss at the
+        // edges): a quad without a live lane writes its derivatives to the
+        // spare slot kMaxQuadSlots, and no lane names its slot.
         for (int q = 0; q < 4; ++q) {
-            if (!B.quad_live(q)) continue;
+            const bool quad_live = B.quad_live(q);
+            const int at = quad_live ? slots : kMaxQuadSlots;
             slot_of |= std::uint32_t(slots) << (8 * q);
-            set_derivatives<NV>(s, B, 4 * q, slots);
-            set_more_derivatives<NV>(s, B, 4 * q, slots);
-            ++slots;
+            set_derivatives<NV>(s, B, 4 * q, at);
+            set_more_derivatives<NV>(s, B, 4 * q, at);
+            slots += quad_live;
         }
         first[b] = std::uint8_t(n);
         const int nb = __builtin_popcount(B.mask);
