@@ -85,11 +85,13 @@ inline void interpolate_lane(const TriangleSetup& t, const TriangleVaryings<NV>&
 
 // The live lanes (`lanes`) whose centre is outside the triangle move to the
 // centroid of their covered samples: interpolate_lane() there, eight lanes
-// at a time. Coverage by the exact integer tests of the block loop, then
-// each lane's sums in sample order, as the per-lane reference takes them.
+// at a time. Coverage by the exact integer tests of the block loop (or its
+// own per-sample masks, `block_cover`, whose live lanes those tests give
+// alike), then each lane's sums in sample order, as the per-lane reference
+// takes them.
 template <int NV>
 void interpolate_centroids(const TriangleSetup& t, const TriangleVaryings<NV>& p, const SamplePattern& sp, int bx,
-                           int by, std::uint32_t lanes, FragmentBlock<NV>& in) {
+                           int by, std::uint32_t lanes, FragmentBlock<NV>& in, const std::uint32_t* block_cover) {
     alignas(32) std::int64_t offset[3][kBlockLanes];
     std::int64_t e0[3];
     std::uint32_t centre = 0xFFFFu;
@@ -101,13 +103,17 @@ void interpolate_centroids(const TriangleSetup& t, const TriangleVaryings<NV>& p
     const std::uint32_t off_centre = lanes & ~centre;
     if (!off_centre) return;
     in.centroid_mask = off_centre;
-    std::uint32_t cover[kMaxSamples];
-    for (int s = 0; s < sp.count; ++s) {
-        std::uint32_t m = 0xFFFFu;
-        for (int e = 0; e < 3; ++e)
-            m &= nonnegative_mask(e0[e] + std::int64_t(t.A[e]) * sp.fixed_x(s) + std::int64_t(t.B[e]) * sp.fixed_y(s),
-                                  offset[e]);
-        cover[s] = m;
+    std::uint32_t own[kMaxSamples];
+    const std::uint32_t* cover = block_cover;
+    if (!cover) {
+        for (int s = 0; s < sp.count; ++s) {
+            std::uint32_t m = 0xFFFFu;
+            for (int e = 0; e < 3; ++e)
+                m &= nonnegative_mask(e0[e] + std::int64_t(t.A[e]) * sp.fixed_x(s) + std::int64_t(t.B[e]) * sp.fixed_y(s),
+                                      offset[e]);
+            own[s] = m;
+        }
+        cover = own;
     }
     typedef std::int32_t Int8 __attribute__((vector_size(32)));
     const Int8 bit = {1, 2, 4, 8, 16, 32, 64, 128};
@@ -163,11 +169,12 @@ void interpolate_centroids(const TriangleSetup& t, const TriangleVaryings<NV>& p
 // triangle move to the centroid of their covered samples.
 // `centre`: the lanes' centre barycentrics and depths when the caller has
 // them (one sample: test_depth's), else null. `inside`: every centre is
-// known to be inside (BlockSamples::inside), so none moves.
+// known to be inside (BlockSamples::inside), so none moves. `cover`: the
+// block loop's coverage of each sample (BlockSamples::cover), or null.
 template <bool MS, int NV>
 void interpolate_block(const TriangleSetup& t, const TriangleVaryings<NV>& p, const SamplePattern& sp, int bx,
                        int by, std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in,
-                       bool inside = false) {
+                       bool inside = false, const std::uint32_t* cover = nullptr) {
     alignas(64) float cb0[kBlockLanes], cb1[kBlockLanes], cb2[kBlockLanes];
     const float *b0 = cb0, *b1 = cb1, *b2 = cb2;
     if (centre) {
@@ -199,7 +206,7 @@ void interpolate_block(const TriangleSetup& t, const TriangleVaryings<NV>& p, co
     }
     in.centroid_mask = 0;
     if constexpr (MS) {
-        if (!inside) interpolate_centroids(t, p, sp, bx, by, lanes, in);
+        if (!inside) interpolate_centroids(t, p, sp, bx, by, lanes, in, cover);
     }
 }
 
@@ -283,8 +290,9 @@ inline void write_color(float* color, std::size_t row, std::uint32_t mask, const
 // A block's fragment inputs: its lanes interpolated, its place, mask and triangle.
 template <bool MS, int NV>
 inline void fill_block(const TriangleSetup& t, const TriangleVaryings<NV>& pv, const TileContext& c, int bx, int by,
-                       std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in, bool inside = false) {
-    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, lanes, centre, in, inside);
+                       std::uint32_t lanes, const BlockSamples* centre, FragmentBlock<NV>& in, bool inside = false,
+                       const std::uint32_t* cover = nullptr) {
+    interpolate_block<MS, NV>(t, pv, *c.samples, bx, by, lanes, centre, in, inside, cover);
     in.x = bx;
     in.y = by;
     in.mask = lanes;
@@ -310,7 +318,7 @@ void shade_in_order(const Program& program, const DrawState& st, const TriangleS
     if (!bs.any_pass) return;
 
     FragmentBlock<NV> in;
-    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, MS ? nullptr : &bs, in, bs.inside);
+    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, MS ? nullptr : &bs, in, bs.inside, bs.cover);
     FragmentOut out;
     out.kill = 0;
     program.fragment(in, out);
@@ -459,7 +467,7 @@ template <bool MS, class Program>
     if (popcount16(bs.any_pass) > kBatchBlockLanes && !(batch.count && batch.fits(bs.any_pass))) {
         if (batch.holds_block(bx, by)) flush_batch<MS>(program, batch, c, st.blend, true);
         FragmentBlock<NV> in;
-        fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, in, bs.inside);
+        fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, in, bs.inside, bs.cover);
         FragmentOut out;
         out.kill = 0;
         program.fragment(in, out);
@@ -468,7 +476,7 @@ template <bool MS, class Program>
     }
     if (!batch.fits(bs.any_pass)) flush_batch<MS>(program, batch, c, st.blend, true);
     const int i = batch.add(bs.any_pass);
-    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, batch.in[i], bs.inside);
+    fill_block<MS, NV>(t, pv, c, bx, by, bs.any_pass, centre, batch.in[i], bs.inside, bs.cover);
     for (int s = 0; s < samples_of<MS>(c); ++s) batch.write[i][s] = bs.pass[s];
 }
 
