@@ -605,13 +605,8 @@ template <class V, int C, class Isa>
                 auto channel = [&](auto cc) __attribute__((always_inline)) {
                     constexpr int c = decltype(cc)::value;
                     if (!((need >> c) & 1u)) return;
-                    I top, bottom;
-                    if constexpr (kSrgb) {
-                        pair_rows_vbmi<Isa, C, c>(qa, qc, la, ha, lc, hc, srgb_codes[c] != nullptr, top, bottom);
-                    } else {
-                        top = pair_linear<Isa, C, c>(qa);
-                        bottom = pair_linear<Isa, C, c>(qc);
-                    }
+                    I top, bottom;  // (the code bytes are read only where kSrgb made them)
+                    pair_rows_vbmi<Isa, C, c>(qa, qc, la, ha, lc, hc, kSrgb && srgb_codes[c] != nullptr, top, bottom);
                     result[c] = bilerp_pairs<V>(top, bottom, wx, wy);
                 };
                 channel(std::integral_constant<int, 0>());
