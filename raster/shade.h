@@ -85,10 +85,10 @@ inline void interpolate_lane(const TriangleSetup& t, const TriangleVaryings<NV>&
 
 // The live lanes (`lanes`) whose centre is outside the triangle move to the
 // centroid of their covered samples: interpolate_lane() there, eight lanes
-// at a time. Coverage by the exact integer tests of the block loop (or its
-// own per-sample masks, `block_cover`, whose live lanes those tests give
-// alike), then each lane's sums in sample order, as the per-lane reference
-// takes them.
+// at a time. Coverage: the block loop's per-sample masks (`block_cover`,
+// BlockSamples::cover, which agree with these tests on live lanes), or where
+// the caller has none the block loop's exact integer tests done here; then
+// each lane's sums in sample order, as the per-lane reference takes them.
 template <int NV>
 void interpolate_centroids(const TriangleSetup& t, const TriangleVaryings<NV>& p, const SamplePattern& sp, int bx,
                            int by, std::uint32_t lanes, FragmentBlock<NV>& in, const std::uint32_t* block_cover) {
