@@ -19,6 +19,8 @@ namespace prast {
 
 constexpr int lane_x(int lane) { return ((lane >> 2) & 1) * 2 + (lane & 1); }
 constexpr int lane_y(int lane) { return ((lane >> 3) & 1) * 2 + ((lane >> 1) & 1); }
+// The lane of the block's pixel (x, y), 0 <= x, y < 4: the inverse of the two above.
+constexpr int block_lane(int x, int y) { return (x & 1) | ((y & 1) << 1) | ((x >> 1) << 2) | ((y >> 1) << 3); }
 
 template <int NV>
 struct FragmentBlock {

@@ -145,9 +145,11 @@ void line_block(const Program& program, const DrawState& st, bool depth_only, co
         if (st.depth_write) store_block(tg.depth + o + s * tg.plane, tg.row, m, z, inside);
         if constexpr (kShade) {
             if (depth_only) continue;  // as depth-only triangles: colour and winners untouched
-            if (tg.color) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, st.blend, inside);
             if (tg.winner) store_winner(tg.winner + tg.winner_offset(bx, by) + s * tg.wplane, tg.wrow, m, kNoWinner);
         }
+    }
+    if constexpr (kShade) {
+        if (!depth_only && tg.color) write_planes(tg, o, S, pass, live, out, st.blend, inside);
     }
 }
 

@@ -19,7 +19,9 @@
 #include "raster/bin.h"
 #include "raster/draw_state.h"
 #include "raster/fragment.h"
+#include "raster/isa.h"
 #include "raster/rasterize.h"
+#include "raster/write_avx512.h"
 
 namespace prast {
 namespace raster_detail {
@@ -287,6 +289,33 @@ inline void write_color(float* color, std::size_t row, std::uint32_t mask, const
 #endif
 }
 
+// write_color() into sample planes s < S of the block at offset o of the
+// target's planes, of the lanes write[s] & live. Replacing, with AVX-512,
+// one masked store a row and plane (write_avx512.h).
+inline void write_planes(const TileTarget& tg, std::size_t o, int S, const std::uint32_t* write, std::uint32_t live,
+                         const FragmentOut& out, Blend blend, bool inside) {
+#if PRAST_CALLS_AVX512 || (defined(PRAST_SIMD16) && defined(__AVX512VL__))
+    if (blend == Blend::Replace
+#if PRAST_CALLS_AVX512
+        && use_avx512()
+#endif
+    ) {
+        std::uint32_t masks[kMaxSamples];
+        for (int s = 0; s < S; ++s) masks[s] = write[s] & live;
+#if PRAST_CALLS_AVX512
+        write_planes_avx512(tg.color + o * 4, tg.row, tg.plane, masks, S, out);
+#else
+        write_planes_avx512_inline<0>(tg.color + o * 4, tg.row, tg.plane, masks, S, out);
+#endif
+        return;
+    }
+#endif
+    for (int s = 0; s < S; ++s) {
+        const std::uint32_t m = write[s] & live;
+        if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, blend, inside);
+    }
+}
+
 // A block's fragment inputs: its lanes interpolated, its place, mask and triangle.
 template <bool MS, int NV>
 inline void fill_block(const TriangleSetup& t, const TriangleVaryings<NV>& pv, const TileContext& c, int bx, int by,
@@ -336,9 +365,9 @@ void shade_in_order(const Program& program, const DrawState& st, const TriangleS
         const std::uint32_t m = bs.pass[s] & live;
         if (!m) continue;
         if (st.depth_write) store_block(tg.depth + o + s * tg.plane, tg.row, m, bs.z[s], inside);
-        if (tg.color) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, st.blend, inside);
         if (tg.winner) store_winner(tg.winner + tg.winner_offset(bx, by) + s * tg.wplane, tg.wrow, m, kNoWinner);
     }
+    if (tg.color) write_planes(tg, o, samples_of<MS>(c), bs.pass, live, out, st.blend, inside);
 }
 
 // Shades the pixels `lanes` of a block for the triangle that won samples
@@ -364,11 +393,7 @@ void shade_winner(const Program& program, const float* vertices, const BinJob& j
 
     const TileTarget& tg = c.target;
     const std::size_t o = tg.offset(bx, by);
-    const bool inside = block_inside(c, bx, by);
-    for (int s = 0; s < samples_of<MS>(c); ++s) {
-        const std::uint32_t m = won[s] & live;
-        if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, Blend::Replace, inside);
-    }
+    write_planes(tg, o, samples_of<MS>(c), won, live, out, Blend::Replace, block_inside(c, bx, by));
 }
 
 // Sparse blocks of one draw waiting for one fragment_batch() call, each with
@@ -413,11 +438,7 @@ inline void write_block(TileContext& c, int bx, int by, std::uint32_t lanes, con
     const TileTarget& tg = c.target;
     if (!tg.color) return;
     const std::size_t o = tg.offset(bx, by);
-    const bool inside = block_inside(c, bx, by);
-    for (int s = 0; s < samples_of<MS>(c); ++s) {
-        const std::uint32_t m = write[s] & live;
-        if (m) write_color(tg.color + (o + s * tg.plane) * 4, tg.row, m, out, blend, inside);
-    }
+    write_planes(tg, o, samples_of<MS>(c), write, live, out, blend, block_inside(c, bx, by));
 }
 
 // Shades the batch with one call and writes its blocks back in the order

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <string>
@@ -1883,6 +1884,72 @@ TEST_CASE("stats: a back face split by clipping counts once in triangles_culled_
     c = draw_counts(r, W, H, clip, {0, 1, 2}, CullMode::None, &s);
     CHECK(count_not_equal(c, 1) == 0);
     CHECK(s.triangles_setup >= 2);
+}
+
+// raster/shade.h write_planes(), Replace: exactly the masked lanes of each
+// sample plane get the block's colours, nothing else is touched, for every
+// sample count, random masks (full and empty ones too) and a block whose
+// lower rows lie past the end of its plane (the one-sample framebuffer's
+// last rows; AddressSanitizer would see a store there). Where the CPU has
+// AVX-512 this is the masked-store copy (write_avx512.h), and the test also
+// calls write_color(), the AVX2 and portable path, for the same result.
+TEST_CASE("colour write: each sample plane gets exactly its masked lanes, AVX-512 copy and default alike") {
+    constexpr float kUntouched = -7.0f;
+    std::uint32_t seed = 12345u;
+    auto next = [&] {
+        seed = seed * 1664525u + 1013904223u;
+        return seed >> 8;
+    };
+    FragmentOut out;
+    for (int l = 0; l < kBlockLanes; ++l) {
+        out.r[l] = float(l) + 0.25f;
+        out.g[l] = float(l) + 0.5f;
+        out.b[l] = -float(l);
+        out.a[l] = 1.0f / float(l + 1);
+    }
+    for (int S : {1, 2, 4, 8}) {
+        for (int trial = 0; trial < 200; ++trial) {
+            // Planes of 6 x 4 pixels (row 6, block at x = 2), or the last plane
+            // only 2 rows high: then only lanes 0-7 (rows 0, 1) may be set.
+            const bool short_last = trial % 4 == 3;
+            const std::size_t row = 6, plane = row * 4;
+            const std::size_t size = (plane * std::size_t(S) - (short_last ? 2 * row : 0)) * 4;
+            std::uint32_t write[kMaxSamples];
+            for (int s = 0; s < S; ++s) {
+                const std::uint32_t pick = next() % 4;
+                write[s] = pick == 0 ? 0u : pick == 1 ? 0xFFFFu : next() & 0xFFFFu;
+                if (short_last && s == S - 1) write[s] &= 0xFFu;
+            }
+            const std::uint32_t live = trial % 5 == 0 ? (next() & 0xFFFFu) : 0xFFFFu;
+            std::vector<float> expect(size, kUntouched);
+            for (int s = 0; s < S; ++s)
+                for (int l = 0; l < kBlockLanes; ++l) {
+                    if (!((write[s] & live) >> l & 1u)) continue;
+                    const std::size_t at = (std::size_t(s) * plane + std::size_t(lane_y(l)) * row + 2 + std::size_t(lane_x(l))) * 4;
+                    expect[at] = out.r[l];
+                    expect[at + 1] = out.g[l];
+                    expect[at + 2] = out.b[l];
+                    expect[at + 3] = out.a[l];
+                }
+            // Its own allocation, so that a store past `size` is a heap overflow.
+            std::unique_ptr<float[]> got(new float[size]);
+            std::fill(got.get(), got.get() + size, kUntouched);
+            TileTarget tg;
+            tg.color = got.get();
+            tg.row = row;
+            tg.plane = plane;
+            raster_detail::write_planes(tg, 2, S, write, live, out, Blend::Replace, false);
+            bool same = std::equal(expect.begin(), expect.end(), got.get());
+            CHECK_MESSAGE(same, "write_planes, samples " << S << ", trial " << trial);
+            std::fill(got.get(), got.get() + size, kUntouched);
+            for (int s = 0; s < S; ++s)
+                if (write[s] & live)
+                    raster_detail::write_color(got.get() + (std::size_t(s) * plane + 2) * 4, row, write[s] & live, out,
+                                               Blend::Replace, false);
+            same = std::equal(expect.begin(), expect.end(), got.get());
+            CHECK_MESSAGE(same, "write_color, samples " << S << ", trial " << trial);
+        }
+    }
 }
 
 } // TEST_SUITE
