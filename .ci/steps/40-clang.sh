@@ -30,11 +30,12 @@ if grep -q "warning:" build-clang/build.log; then
 fi
 built=$(date +%s)
 build-clang/render --version
-# The AVX-512 copy of the block loops and the fetch's VBMI copy share no
+# The AVX-512 copies of the block loops and the fetch's VBMI copy share no
 # code with the rest under Clang either (tests/check_isa.sh; the objects
 # exist in x86-64-v3 builds).
 isa_obj=$(find build-clang -name 'sample_lanes_avx512.cpp.o' | head -n 1)
 vbmi_obj=$(find build-clang -name 'sample_lanes_vbmi.cpp.o' | head -n 1)
-[ -z "$isa_obj" ] || sh tests/check_isa.sh "$isa_obj" "$vbmi_obj"
+write_obj=$(find build-clang -name 'write_avx512.cpp.o' | head -n 1)
+[ -z "$isa_obj" ] || sh tests/check_isa.sh "$isa_obj" "$vbmi_obj" "$write_obj"
 python3 scripts/manifest.py check --render build-clang/render
 echo "clang step: build $((built - start)) s, manifest $(($(date +%s) - built)) s"
