@@ -1,7 +1,8 @@
 // The colour write of a shaded block (shade.h write_color(), blending
-// Replace) with AVX-512: each row of the block one masked 64-byte store a
-// sample plane, with no branch on which pixels the edges left (at a
-// triangle's edge a coin toss, which the pair-by-pair AVX2 stores
+// Replace) with AVX-512: the block's pixels put in row order once, then each
+// row one masked 64-byte store a sample plane (a half block whose pixels are
+// all written: plain stores), with no branch on which pixels the edges left
+// (at a triangle's edge a coin toss, which the pair-by-pair AVX2 stores
 // mispredicted). An x86-64-v3 build compiles it in write_avx512.cpp alone and
 // calls it there where the CPU has AVX-512 (isa.h); an x86-64-v4 build
 // inlines it.
